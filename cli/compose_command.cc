@@ -1,0 +1,136 @@
+#include "cli/compose_command.h"
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <tbb/global_control.h>
+
+#include "cli/provenance.h"
+#include "core/annotation.h"
+#include "core/atomic_file.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "core/tum_io.h"
+#include "montage/compose.h"
+
+namespace mmh::cli {
+namespace {
+
+struct ComposeArgs {
+  CommonFlags common;
+  std::vector<std::string> takes;
+  std::vector<std::string> annotations;
+};
+
+std::string TimelineCsv(const montage::Montage& montage) {
+  std::ostringstream out;
+  out << "reference_frame,take";
+  const std::size_t m = montage.warped_annotations.size();
+  for (std::size_t l = 0; l < m; ++l) out << ",warp_" << l;
+  for (std::size_t l = 0; l < m; ++l) out << ",warped_annotation_" << l;
+  out << '\n';
+  for (std::size_t t = 0; t < montage.labels.size(); ++t) {
+    out << t << ',' << montage.labels[t];
+    for (std::size_t l = 0; l < m; ++l) out << ',' << montage.warps[l][t];
+    for (std::size_t l = 0; l < m; ++l) out << ',' << FormatNumber(montage.warped_annotations[l][t]);
+    out << '\n';
+  }
+  return out.str();
+}
+
+void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
+  Config config;
+  if (!args.common.config_file.empty()) config = Config::Load(args.common.config_file);
+  for (const auto& set : args.common.sets) config.Set(set);
+  config.RequireOnlySections({"montage"});
+  const auto options = config.Get<montage::ComposeOptions>("montage");
+
+  if (args.takes.size() != args.annotations.size()) {
+    ThrowBadValue("--annotations", std::to_string(args.annotations.size()) + " files for " +
+                                       std::to_string(args.takes.size()) + " takes",
+                  "one annotation file per take, in the same order");
+  }
+  std::unique_ptr<tbb::global_control> threads;
+  if (args.common.threads > 0) {
+    threads = std::make_unique<tbb::global_control>(
+        tbb::global_control::max_allowed_parallelism, args.common.threads);
+  }
+
+  // Everything is read and computed before anything is written: bad input leaves no output.
+  std::vector<Trajectory> takes;
+  std::vector<Annotation> annotations;
+  std::vector<std::string> names;
+  for (const auto& path : args.takes) {
+    takes.push_back(ReadTum(path));
+    names.push_back(path);
+  }
+  for (const auto& path : args.annotations) {
+    annotations.push_back(ReadAnnotationCsv(path));
+    names.push_back(path);
+  }
+  const montage::Montage montage = montage::Compose(takes, annotations, options, names);
+
+  nlohmann::json resolved;
+  resolved["montage"] = ToJson(options);
+  nlohmann::json summary = montage::SummaryToJson(montage.summary, montage.segments);
+  summary["take_files"] = args.takes;
+  summary["annotation_files"] = args.annotations;
+
+  const std::filesystem::path out = args.common.out_dir;
+  EnsureDirectory(out);
+  WriteTum(out / "montage.tum", montage.trajectory,
+           "MotionMontage montage of " + std::to_string(takes.size()) + " takes (mmh compose)\n" +
+               "timestamp tx ty tz qx qy qz qw");
+  WriteFileAtomically(out / "segments.csv", montage::SegmentsToCsv(montage.segments));
+  WriteFileAtomically(out / "timeline.csv", TimelineCsv(montage));
+  WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
+  WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
+  WriteFileAtomically(out / "run.json",
+                      Provenance(argv, resolved, args.common.threads, summary["seconds"]).dump(2) +
+                          "\n");
+
+  if (!args.common.quiet) {
+    const auto& s = montage.summary;
+    std::cout << "montage: " << s.montage_frames << " frames from " << s.takes << " takes, "
+              << montage.segments.size() << " segments (shortest " << s.shortest_segment_reference
+              << " reference frames)\n"
+              << "cost: total " << s.total_cost << " = data " << s.data_cost << " + smoothness "
+              << s.smoothness_cost << "; without the segment constraint " << s.unconstrained_cost
+              << " (+" << s.constraint_increase_percent << " %, "
+              << s.unconstrained_short_segments << " short segments avoided)\n"
+              << "time: " << s.seconds.total * 1e3 << " ms (dtw " << s.seconds.dtw * 1e3
+              << ", smoothness " << s.seconds.smoothness * 1e3 << ", labelling "
+              << s.seconds.labelling * 1e3 << ")\n";
+    for (const auto& w : s.warnings) std::cout << "warning: " << w << '\n';
+    std::cout << "written: " << out.string() << "/{montage.tum, segments.csv, timeline.csv, "
+              << "summary.json, config.resolved.json, run.json}\n";
+  }
+}
+
+}  // namespace
+
+void AddComposeCommand(CLI::App& app, const std::vector<std::string>& argv) {
+  auto args = std::make_shared<ComposeArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "compose", "Montage from take trajectories (TUM) and their annotations (CSV)");
+  cmd->add_option("--takes", args->takes, "Take trajectories (TUM); the first is the reference")
+      ->required()
+      ->expected(1, -1);
+  cmd->add_option("--annotations", args->annotations,
+                  "Annotation CSVs (timestamp,value), one per take, same order")
+      ->required()
+      ->expected(1, -1);
+  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
+  cmd->add_option("--config", args->common.config_file, "JSON config with a 'montage' section");
+  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
+      ->take_all();
+  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  cmd->callback([args, argv] { RunCompose(*args, argv); });
+}
+
+}  // namespace mmh::cli

@@ -1,0 +1,24 @@
+// `mmh compose`: a montage from take trajectories (TUM) and annotations (CSV).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace mmh::cli {
+
+struct CommonFlags {
+  std::string config_file;
+  std::vector<std::string> sets;
+  std::string out_dir;
+  int threads = 0;
+  bool quiet = false;
+};
+
+// Registers the subcommand; `argv` is kept for run.json.
+void AddComposeCommand(CLI::App& app, const std::vector<std::string>& argv);
+
+}  // namespace mmh::cli

@@ -1,0 +1,82 @@
+#include "cli/provenance.h"
+
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <memory>
+
+#include <Eigen/Core>
+#include <tbb/version.h>
+
+#ifndef MMH_SOURCE_DIR
+#define MMH_SOURCE_DIR "."
+#endif
+
+namespace mmh::cli {
+namespace {
+
+std::string Run(const std::string& command) {
+  std::array<char, 256> buffer{};
+  std::string output;
+  std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+  if (!pipe) return "";
+  while (fgets(buffer.data(), buffer.size(), pipe.get())) output += buffer.data();
+  while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();
+  return output;
+}
+
+}  // namespace
+
+std::string GitCommit() {
+  const std::string dir = MMH_SOURCE_DIR;
+  const std::string commit = Run("git -C '" + dir + "' rev-parse HEAD 2>/dev/null");
+  if (commit.empty()) return "unknown";
+  const std::string dirty = Run("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null");
+  return dirty.empty() ? commit : commit + "-dirty";
+}
+
+std::string ConfigHash(const nlohmann::json& resolved_config) {
+  std::uint64_t hash = 1469598103934665603ull;
+  for (unsigned char c : resolved_config.dump()) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+nlohmann::json Provenance(const std::vector<std::string>& argv, const nlohmann::json& resolved_config,
+                          int threads, const nlohmann::json& timings) {
+  nlohmann::json run;
+  run["command"] = argv;
+  run["mmh_version"] = MMH_VERSION;
+  run["git_commit"] = GitCommit();
+  run["config_hash"] = ConfigHash(resolved_config);
+  char host[256] = {0};
+  gethostname(host, sizeof(host) - 1);
+  run["host"] = host;
+  run["threads"] = threads;
+  run["hardware_threads"] = static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
+  run["libraries"] = {
+      {"eigen", std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) +
+                    "." + std::to_string(EIGEN_MINOR_VERSION)},
+      {"tbb", TBB_VERSION_STRING},
+      {"nlohmann_json", std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +
+                            std::to_string(NLOHMANN_JSON_VERSION_MINOR) + "." +
+                            std::to_string(NLOHMANN_JSON_VERSION_PATCH)},
+      {"compiler", __VERSION__},
+  };
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  run["finished_utc"] = stamp;
+  run["seconds"] = timings;
+  return run;
+}
+
+}  // namespace mmh::cli

@@ -1,0 +1,98 @@
+#include "core/annotation.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/text_parsing.h"
+
+namespace mmh {
+namespace {
+
+void CheckValue(double value, const std::string& where) {
+  if (!std::isfinite(value) || value < kMinAnnotation || value > kMaxAnnotation) {
+    ThrowBadValue(where + ", value", FormatNumber(value), "a number in [-5, 5]");
+  }
+}
+
+}  // namespace
+
+Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
+  const std::string text = ReadTextFile(path);
+  Annotation annotation;
+  std::istringstream lines(text);
+  std::string line;
+  std::size_t line_number = 0;
+  bool header_seen = false;
+  while (std::getline(lines, line)) {
+    ++line_number;
+    const std::string_view content = Trim(line);
+    if (content.empty()) continue;
+    const std::string where = path.string() + ":" + std::to_string(line_number);
+    if (!header_seen) {
+      const auto names = SplitFields(content, ",");
+      if (names.size() != 2 || Trim(names[0]) != "timestamp" || Trim(names[1]) != "value") {
+        ThrowBadValue(where, "the header '" + std::string(content) + "'",
+                      "the header 'timestamp,value'");
+      }
+      header_seen = true;
+      continue;
+    }
+    const auto fields = SplitFields(content, ",");
+    if (fields.size() != 2) {
+      ThrowBadValue(where, std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
+                    "2 fields: timestamp,value");
+    }
+    double timestamp = 0.0, value = 0.0;
+    if (!ParseDouble(fields[0], &timestamp) || !std::isfinite(timestamp)) {
+      ThrowBadValue(where + ", timestamp", "'" + std::string(fields[0]) + "'", "a finite number");
+    }
+    if (!ParseDouble(fields[1], &value)) {
+      ThrowBadValue(where + ", value", "'" + std::string(fields[1]) + "'", "a number in [-5, 5]");
+    }
+    CheckValue(value, where);
+    if (!annotation.timestamps.empty() && !(timestamp > annotation.timestamps.back())) {
+      ThrowBadValue(where + ", timestamp", FormatNumber(timestamp),
+                    "greater than the previous timestamp " +
+                        FormatNumber(annotation.timestamps.back()));
+    }
+    annotation.timestamps.push_back(timestamp);
+    annotation.values.push_back(value);
+  }
+  if (annotation.values.empty()) {
+    ThrowBadValue(path.string(), header_seen ? "a header but no rows" : "an empty file",
+                  "the header 'timestamp,value' and one row per frame");
+  }
+  return annotation;
+}
+
+void ValidateAnnotation(const Annotation& annotation, const std::string& name) {
+  if (annotation.timestamps.size() != annotation.values.size()) {
+    ThrowBadValue(name, std::to_string(annotation.timestamps.size()) + " timestamps for " +
+                            std::to_string(annotation.values.size()) + " values",
+                  "one timestamp per value");
+  }
+  for (std::size_t i = 0; i < annotation.size(); ++i) {
+    const std::string where = name + ", frame " + std::to_string(i);
+    CheckValue(annotation.values[i], where);
+    if (!std::isfinite(annotation.timestamps[i]) ||
+        (i > 0 && !(annotation.timestamps[i] > annotation.timestamps[i - 1]))) {
+      ThrowBadValue(where + ", timestamp", FormatNumber(annotation.timestamps[i]),
+                    "finite and greater than the previous timestamp");
+    }
+  }
+}
+
+void WriteAnnotationCsv(const std::filesystem::path& path, const Annotation& annotation) {
+  ValidateAnnotation(annotation, path.string());
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "timestamp,value\n";
+    for (std::size_t i = 0; i < annotation.size(); ++i) {
+      out << FormatNumber(annotation.timestamps[i]) << ',' << FormatNumber(annotation.values[i])
+          << '\n';
+    }
+  });
+}
+
+}  // namespace mmh

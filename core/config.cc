@@ -1,0 +1,94 @@
+#include "core/config.h"
+
+#include "core/error.h"
+#include "core/text_parsing.h"
+
+namespace mmh {
+
+Config Config::Load(const std::filesystem::path& path) {
+  const std::string text = ReadTextFile(path);
+  Config config;
+  config.file_ = path.string();
+  try {
+    config.root_ = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    // Byte offset -> line and column.
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    throw InputError(path.string() + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                     ": invalid JSON (" + e.what() + ")");
+  }
+  if (!config.root_.is_object()) {
+    ThrowBadValue(path.string(), "a JSON " + std::string(config.root_.type_name()),
+                  "a JSON object with one key per section, e.g. {\"montage\": {...}}");
+  }
+  return config;
+}
+
+void Config::Set(const std::string& assignment) {
+  const std::size_t eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    ThrowBadValue("--set " + assignment, "no 'key.path=value'", "key.path=value");
+  }
+  const std::string key_path = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  nlohmann::json value;
+  try {
+    value = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error&) {
+    value = text;
+  }
+  nlohmann::json* node = &root_;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t dot = key_path.find('.', start);
+    const std::string name = key_path.substr(start, dot == std::string::npos ? dot : dot - start);
+    if (name.empty()) ThrowBadValue("--set " + assignment, "an empty key", "key.path=value");
+    if (!node->is_object()) {
+      ThrowBadValue("--set " + assignment, "a key inside a non-object value", "a key of an object");
+    }
+    if (dot == std::string::npos) {
+      (*node)[name] = value;
+      break;
+    }
+    node = &(*node)[name];
+    if (node->is_null()) *node = nlohmann::json::object();
+    start = dot + 1;
+  }
+  overrides_[key_path] = assignment;
+}
+
+ConfigSource Config::SourceOf(const std::string& key_path) const {
+  // The most specific --set at or below this key wins; otherwise the file.
+  std::string sets;
+  for (const auto& [key, assignment] : overrides_) {
+    if (key == key_path || key.rfind(key_path + ".", 0) == 0 || key_path.rfind(key + ".", 0) == 0) {
+      sets += (sets.empty() ? "" : ", ") + ("--set " + assignment);
+    }
+  }
+  std::string name = file_.empty() ? "config" : file_;
+  if (!sets.empty()) name = file_.empty() ? sets : name + " with " + sets;
+  return ConfigSource{name};
+}
+
+void Config::RequireOnlySections(const std::vector<std::string>& sections) const {
+  for (auto it = root_.begin(); it != root_.end(); ++it) {
+    bool known = false;
+    for (const auto& s : sections) known = known || s == it.key();
+    if (!known) {
+      const std::string suggestion = options_internal::SuggestName(it.key(), sections);
+      throw InputError(SourceOf(it.key()).name + ": section '" + it.key() + "' is unknown" +
+                       (suggestion.empty() ? "" : " (did you mean '" + suggestion + "'?)") +
+                       "; this command reads: " + options_internal::JoinNames(sections));
+    }
+  }
+}
+
+}  // namespace mmh

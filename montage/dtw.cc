@@ -1,0 +1,485 @@
+#include "montage/dtw.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "core/error.h"
+#include "montage/match_cost.h"
+
+// Clones of the hot loops for AVX-512 and AVX2 machines, chosen at load time; the baseline build
+// stays portable. -ffp-contract=off (CMakeLists.txt) keeps every clone's rounding identical.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define MMH_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define MMH_SIMD_CLONES
+#endif
+
+namespace mmh::montage {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Pruning granularity: blocks of 16 source frames (four blocks per 64-bit backtracking word).
+constexpr int kBlock = 16;
+
+using Clock = std::chrono::steady_clock;
+
+// Poses as structure of arrays, so that the cost loops vectorise.
+struct PoseArrays {
+  std::vector<double> qx, qy, qz, qw, tx, ty, tz;
+  explicit PoseArrays(const Trajectory& trajectory) {
+    const std::size_t n = trajectory.size();
+    for (auto* v : {&qx, &qy, &qz, &qw, &tx, &ty, &tz}) v->resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& p = trajectory.poses[i];
+      qx[i] = p.rotation.x();
+      qy[i] = p.rotation.y();
+      qz[i] = p.rotation.z();
+      qw[i] = p.rotation.w();
+      tx[i] = p.translation.x();
+      ty[i] = p.translation.y();
+      tz[i] = p.translation.z();
+    }
+  }
+  int size() const { return static_cast<int>(qx.size()); }
+};
+
+// out[i] = C_match(reference frame t, source frame first + i) for i < count.
+MMH_SIMD_CLONES
+void CostRun(const PoseArrays& ref, int t, const PoseArrays& src, int first, int count,
+             double lambda, double* __restrict out) {
+  const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
+  const double atx = ref.tx[t], aty = ref.ty[t], atz = ref.tz[t];
+  const double* __restrict bx = src.qx.data() + first;
+  const double* __restrict by = src.qy.data() + first;
+  const double* __restrict bz = src.qz.data() + first;
+  const double* __restrict bw = src.qw.data() + first;
+  const double* __restrict btx = src.tx.data() + first;
+  const double* __restrict bty = src.ty.data() + first;
+  const double* __restrict btz = src.tz.data() + first;
+  for (int i = 0; i < count; ++i) {
+    out[i] = MatchCost(ax, ay, az, aw, atx, aty, atz, bx[i], by[i], bz[i], bw[i], btx[i], bty[i],
+                       btz[i], lambda);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lower bounds for pruning. Each block of kBlock source frames is enclosed in two balls: one in
+// R^4 around its quaternions (each taken with the sign closest to the block's first one) and one
+// in R^3 around its translations. By the triangle inequality, for every source frame s in block j
+//   C_match(A, T_src(s)) >= max(0, min(|q - c_j|, |q + c_j|) - r_j) + lambda max(0, |x - m_j| - R_j).
+struct BlockBalls {
+  std::vector<double> cx, cy, cz, cw, rq, mx, my, mz, rt;
+};
+
+BlockBalls MakeBlockBalls(const PoseArrays& src) {
+  const int n = src.size();
+  const int blocks = (n + kBlock - 1) / kBlock;
+  BlockBalls b;
+  for (auto* v : {&b.cx, &b.cy, &b.cz, &b.cw, &b.rq, &b.mx, &b.my, &b.mz, &b.rt}) v->resize(blocks);
+  for (int j = 0; j < blocks; ++j) {
+    const int first = j * kBlock, last = std::min(n, first + kBlock);
+    const double inv = 1.0 / (last - first);
+    std::array<double, 4> c{0, 0, 0, 0};
+    std::array<double, 3> m{0, 0, 0};
+    std::array<double, 4> q0{src.qx[first], src.qy[first], src.qz[first], src.qw[first]};
+    auto aligned = [&](int s) {
+      std::array<double, 4> q{src.qx[s], src.qy[s], src.qz[s], src.qw[s]};
+      const double dot = q[0] * q0[0] + q[1] * q0[1] + q[2] * q0[2] + q[3] * q0[3];
+      if (dot < 0) {
+        for (auto& v : q) v = -v;
+      }
+      return q;
+    };
+    for (int s = first; s < last; ++s) {
+      const auto q = aligned(s);
+      for (int k = 0; k < 4; ++k) c[k] += q[k] * inv;
+      m[0] += src.tx[s] * inv;
+      m[1] += src.ty[s] * inv;
+      m[2] += src.tz[s] * inv;
+    }
+    double rq = 0, rt = 0;
+    for (int s = first; s < last; ++s) {
+      const auto q = aligned(s);
+      double dq = 0;
+      for (int k = 0; k < 4; ++k) dq += (q[k] - c[k]) * (q[k] - c[k]);
+      const double dx = src.tx[s] - m[0], dy = src.ty[s] - m[1], dz = src.tz[s] - m[2];
+      rq = std::max(rq, std::sqrt(dq));
+      rt = std::max(rt, std::sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    // Inflate the radii a little so that rounding can never make a bound exceed the true cost.
+    b.cx[j] = c[0], b.cy[j] = c[1], b.cz[j] = c[2], b.cw[j] = c[3];
+    b.mx[j] = m[0], b.my[j] = m[1], b.mz[j] = m[2];
+    b.rq[j] = rq * (1 + 1e-9) + 1e-12;
+    b.rt[j] = rt * (1 + 1e-9) + 1e-12;
+  }
+  return b;
+}
+
+// out[j] = lower bound of C_match(reference frame t, any source frame of block j).
+MMH_SIMD_CLONES
+void LowerBoundRow(const PoseArrays& ref, int t, const BlockBalls& b, int blocks, double lambda,
+                   double* __restrict out) {
+  const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
+  const double atx = ref.tx[t], aty = ref.ty[t], atz = ref.tz[t];
+  for (int j = 0; j < blocks; ++j) {
+    const double dx = ax - b.cx[j], dy = ay - b.cy[j], dz = az - b.cz[j], dw = aw - b.cw[j];
+    const double sx = ax + b.cx[j], sy = ay + b.cy[j], sz = az + b.cz[j], sw = aw + b.cw[j];
+    const double q = std::sqrt(std::min(dx * dx + dy * dy + dz * dz + dw * dw,
+                                        sx * sx + sy * sy + sz * sz + sw * sw));
+    const double ex = atx - b.mx[j], ey = aty - b.my[j], ez = atz - b.mz[j];
+    const double x = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double lb = std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j]);
+    out[j] = lb * (1 - 1e-9);
+  }
+}
+
+// Largest float not above x (x >= 0 or +inf).
+float FloatBelow(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The literal dynamic programme (eq. 4):
+//   F(0, 0) = C(0, 0), F(0, s > 0) = inf,  F(t, s) = C(t, s) + min_{s' <= s} F(t-1, s'),
+// cost F(n-1, N-1), backtracking w(t-1) = argmin_{s' <= w(t)} F(t-1, s') (first minimum).
+// Cells of blocks marked dead are taken as +inf (never evaluated). One bit per cell records "F(t, s)
+// is a new strict prefix minimum of row t", so the argmin is the last set bit at or before w(t):
+// the backtracking store is n * N bits, never a matrix of doubles.
+class LiteralProgramme {
+ public:
+  LiteralProgramme(const PoseArrays& ref, const PoseArrays& src, double lambda)
+      : ref_(ref), src_(src), lambda_(lambda), n_(ref.size()), big_n_(src.size()),
+        blocks_((big_n_ + kBlock - 1) / kBlock), words_((big_n_ + 63) / 64) {}
+
+  // `live(t, j)` says whether block j of row t may hold an optimal cell. Returns the cost (inf if
+  // no warp runs through live cells only) and fills `warp`.
+  template <class Live>
+  double Run(const Live& live, std::vector<int>* warp, std::int64_t* evaluated) {
+    bits_.assign(static_cast<std::size_t>(n_) * words_, 0);
+    std::vector<double> m_prev(big_n_), m_cur(big_n_);
+    std::vector<double> end_prev(blocks_, kInf), end_cur(blocks_, kInf);
+    std::vector<char> live_prev(blocks_, 0), live_cur(blocks_, 0);
+    std::array<double, kBlock> cost{};
+    double last_f = kInf;  // F(n-1, N-1)
+
+    // Row 0: only w(0) = 0 is allowed.
+    {
+      const double c = Cost(0, 0, cost.data());
+      ++*evaluated;
+      m_prev[0] = c;
+      bits_[0] = 1;
+      // Every other cell of row 0 is +inf, so the prefix minimum stays c along the row.
+      for (int j = 0; j < blocks_; ++j) end_prev[j] = c;
+      std::fill(live_prev.begin(), live_prev.end(), 0);
+      live_prev[0] = 1;
+      for (int s = 1; s < std::min(big_n_, kBlock); ++s) m_prev[s] = c;
+      if (n_ == 1) last_f = big_n_ == 1 ? c : kInf;
+    }
+    for (int t = 1; t < n_; ++t) {
+      double carry = kInf;  // prefix minimum of row t so far
+      std::uint64_t* row_bits = bits_.data() + static_cast<std::size_t>(t) * words_;
+      for (int j = 0; j < blocks_; ++j) {
+        const int first = j * kBlock;
+        const int count = std::min(kBlock, big_n_ - first);
+        const double before = j == 0 ? kInf : end_prev[j - 1];
+        // Unreachable from row t-1, or pruned: all +inf.
+        if (!live(t, j) || (!live_prev[j] && before == kInf)) {
+          live_cur[j] = 0;
+          end_cur[j] = carry;
+          continue;
+        }
+        CostRun(ref_, t, src_, first, count, lambda_, cost.data());
+        *evaluated += count;
+        std::uint64_t mask = 0;
+        const double* prev = m_prev.data() + first;
+        double* cur = m_cur.data() + first;
+        for (int i = 0; i < count; ++i) {
+          const double f = cost[i] + (live_prev[j] ? prev[i] : before);
+          if (f < carry) {
+            carry = f;
+            mask |= std::uint64_t{1} << i;
+          }
+          cur[i] = carry;
+          if (t == n_ - 1 && first + i == big_n_ - 1) last_f = f;
+        }
+        row_bits[j / 4] |= mask << (16 * (j % 4));
+        live_cur[j] = 1;
+        end_cur[j] = carry;
+      }
+      std::swap(m_prev, m_cur);
+      std::swap(end_prev, end_cur);
+      std::swap(live_prev, live_cur);
+    }
+    if (!(last_f < kInf)) return kInf;
+    warp->assign(n_, 0);
+    (*warp)[n_ - 1] = big_n_ - 1;
+    for (int t = n_ - 1; t >= 1; --t) (*warp)[t - 1] = LastMinimumAtOrBefore(t - 1, (*warp)[t]);
+    return last_f;
+  }
+
+ private:
+  double Cost(int t, int s, double* scratch) const {
+    CostRun(ref_, t, src_, s, 1, lambda_, scratch);
+    return scratch[0];
+  }
+
+  int LastMinimumAtOrBefore(int t, int s) const {
+    const std::uint64_t* row_bits = bits_.data() + static_cast<std::size_t>(t) * words_;
+    int word = s / 64;
+    std::uint64_t bits = row_bits[word] & (~std::uint64_t{0} >> (63 - s % 64));
+    while (bits == 0) {
+      if (--word < 0) return 0;  // not reached for a finite cost: F(t, 0..s) has a minimum
+      bits = row_bits[word];
+    }
+    return word * 64 + 63 - std::countl_zero(bits);
+  }
+
+  const PoseArrays& ref_;
+  const PoseArrays& src_;
+  double lambda_;
+  int n_, big_n_, blocks_, words_;
+  std::vector<std::uint64_t> bits_;
+};
+
+struct AllLive {
+  bool operator()(int, int) const { return true; }
+};
+
+// The pruned literal DTW. Lower bounds:
+//   FL(t, j) <= min_{s in j} F(t, s): FL(t, j) = lb(t, j) + min_{j' <= j} FL(t-1, j'),
+//   BL(t, j) <= cost of rows t+1..n-1 after any s in j: BL(t, j) = min_{j' >= j} lb(t+1, j') +
+//   BL(t+1, j'), BL(n-1, last) = 0,
+// so every cell of an optimal warp has P(t, j) = FL + BL <= optimum <= U for any feasible cost U.
+// U comes from the programme restricted to a monotone band around the rows' least P; the exact
+// programme then runs over the blocks with P <= U. Both hold the optimum's cells, so the result is
+// the full programme's, warp for warp (the first-minimum tie rule sees the same candidates).
+double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda,
+                     std::vector<int>* warp, std::int64_t* evaluated) {
+  const int n = ref.size(), big_n = src.size();
+  const int blocks = (big_n + kBlock - 1) / kBlock;
+  const BlockBalls balls = MakeBlockBalls(src);
+  // lb(t, j) and then P(t, j) as floats rounded down: #n by #blocks.
+  std::vector<float> lb(static_cast<std::size_t>(n) * blocks);
+  std::vector<float> p(static_cast<std::size_t>(n) * blocks);
+  std::vector<double> row(blocks), acc(blocks);
+  for (int t = 0; t < n; ++t) {
+    LowerBoundRow(ref, t, balls, blocks, lambda, row.data());
+    float* out = lb.data() + static_cast<std::size_t>(t) * blocks;
+    for (int j = 0; j < blocks; ++j) out[j] = FloatBelow(row[j]);
+  }
+  // Backward bounds into p.
+  for (int j = 0; j < blocks; ++j) acc[j] = j == blocks - 1 ? 0.0 : kInf;
+  for (int t = n - 1; t >= 0; --t) {
+    float* out = p.data() + static_cast<std::size_t>(t) * blocks;
+    for (int j = 0; j < blocks; ++j) out[j] = FloatBelow(acc[j]);
+    if (t == 0) break;
+    const float* l = lb.data() + static_cast<std::size_t>(t) * blocks;
+    double suffix = kInf;
+    for (int j = blocks - 1; j >= 0; --j) {
+      suffix = std::min(suffix, static_cast<double>(l[j]) + acc[j]);
+      acc[j] = suffix;
+    }
+  }
+  // Forward bounds, added into p.
+  for (int j = 0; j < blocks; ++j) acc[j] = j == 0 ? static_cast<double>(lb[0]) : kInf;
+  std::vector<int> centre(n, 0);
+  for (int t = 0; t < n; ++t) {
+    const float* l = lb.data() + static_cast<std::size_t>(t) * blocks;
+    if (t > 0) {
+      double prefix = kInf;
+      for (int j = 0; j < blocks; ++j) {
+        prefix = std::min(prefix, acc[j]);
+        acc[j] = static_cast<double>(l[j]) + prefix;
+      }
+    }
+    float* out = p.data() + static_cast<std::size_t>(t) * blocks;
+    float best = std::numeric_limits<float>::infinity();
+    for (int j = 0; j < blocks; ++j) {
+      out[j] = FloatBelow(static_cast<double>(out[j]) + acc[j]);
+      if (out[j] < best) {
+        best = out[j];
+        centre[t] = j;
+      }
+    }
+  }
+  // Upper bound from a monotone band of +-2 blocks around the running maximum of the rows' least
+  // P; it always holds a warp (stay at the band's first frame), so U is finite.
+  for (int t = 1; t < n; ++t) centre[t] = std::max(centre[t], centre[t - 1]);
+  centre[n - 1] = blocks - 1;
+  LiteralProgramme programme(ref, src, lambda);
+  std::vector<int> band_warp;
+  const double upper = programme.Run(
+      [&](int t, int j) { return j >= centre[t] - 2 && j <= centre[t] + 2; }, &band_warp,
+      evaluated);
+  // Margin for the rounding of the bounds' sums.
+  const double threshold = upper * (1 + 1e-9) + 1e-9;
+  const double cost = programme.Run(
+      [&](int t, int j) { return p[static_cast<std::size_t>(t) * blocks + j] <= threshold; }, warp,
+      evaluated);
+  if (cost < kInf) return cost;
+  // Unreachable by the argument above; kept so that a bound bug can never lose the warp.
+  return programme.Run(AllLive{}, warp, evaluated);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The other step patterns: full programmes with one byte of backtracking per cell.
+double SlopeLimited(const PoseArrays& ref, const PoseArrays& src, double lambda,
+                    std::vector<int>* warp, std::int64_t* evaluated) {
+  const int n = ref.size(), big_n = src.size();
+  std::vector<std::uint8_t> step(static_cast<std::size_t>(n) * big_n, 0);
+  std::vector<double> prev(big_n, kInf), cur(big_n), cost(big_n);
+  CostRun(ref, 0, src, 0, big_n, lambda, cost.data());
+  prev[0] = cost[0];
+  for (int t = 1; t < n; ++t) {
+    CostRun(ref, t, src, 0, big_n, lambda, cost.data());
+    for (int s = 0; s < big_n; ++s) {
+      double best = prev[s];
+      std::uint8_t k = 0;
+      for (std::uint8_t d = 1; d <= 2 && d <= s; ++d) {
+        if (prev[s - d] < best) {
+          best = prev[s - d];
+          k = d;
+        }
+      }
+      cur[s] = cost[s] + best;
+      step[static_cast<std::size_t>(t) * big_n + s] = k;
+    }
+    std::swap(prev, cur);
+  }
+  *evaluated += static_cast<std::int64_t>(n) * big_n;
+  warp->assign(n, 0);
+  (*warp)[n - 1] = big_n - 1;
+  for (int t = n - 1; t >= 1; --t) {
+    (*warp)[t - 1] = (*warp)[t] - step[static_cast<std::size_t>(t) * big_n + (*warp)[t]];
+  }
+  return prev[big_n - 1];
+}
+
+double Symmetric(const PoseArrays& ref, const PoseArrays& src, double lambda,
+                 std::vector<int>* warp, std::int64_t* evaluated) {
+  // D(t, s) = C(t, s) + min(D(t-1, s-1), D(t-1, s), D(t, s-1)); moves: 0 diagonal, 1 from the row
+  // above, 2 from the left.
+  const int n = ref.size(), big_n = src.size();
+  std::vector<std::uint8_t> move(static_cast<std::size_t>(n) * big_n, 0);
+  std::vector<double> prev(big_n, kInf), cur(big_n), cost(big_n);
+  for (int t = 0; t < n; ++t) {
+    CostRun(ref, t, src, 0, big_n, lambda, cost.data());
+    for (int s = 0; s < big_n; ++s) {
+      double best = kInf;
+      std::uint8_t k = 0;
+      if (t == 0 && s == 0) best = 0;
+      if (t > 0 && s > 0 && prev[s - 1] < best) best = prev[s - 1], k = 0;
+      if (t > 0 && prev[s] < best) best = prev[s], k = 1;
+      if (s > 0 && cur[s - 1] < best) best = cur[s - 1], k = 2;
+      cur[s] = cost[s] + best;
+      move[static_cast<std::size_t>(t) * big_n + s] = k;
+    }
+    std::swap(prev, cur);
+  }
+  *evaluated += static_cast<std::int64_t>(n) * big_n;
+  // Walk back; w(t) = the smallest s of the path in row t.
+  warp->assign(n, 0);
+  int t = n - 1, s = big_n - 1;
+  while (t > 0 || s > 0) {
+    (*warp)[t] = s;
+    const std::uint8_t k = move[static_cast<std::size_t>(t) * big_n + s];
+    if (k == 0) --t, --s;
+    else if (k == 1) --t;
+    else --s;
+  }
+  (*warp)[0] = 0;
+  return prev[big_n - 1];
+}
+
+constexpr std::pair<StepPattern, const char*> kStepPatternNames[] = {
+    {StepPattern::kLiteral, "literal"},
+    {StepPattern::kSlopeLimited, "slope_limited"},
+    {StepPattern::kSymmetric, "symmetric"},
+};
+
+}  // namespace
+
+std::span<const std::pair<StepPattern, const char*>> EnumNames(StepPattern) {
+  return kStepPatternNames;
+}
+
+void DtwOptions::Validate(const std::string& prefix) const {
+  if (!std::isfinite(lambda) || lambda < 0) {
+    ThrowBadValue(prefix + ".lambda", FormatNumber(lambda), "a finite number >= 0");
+  }
+}
+
+DtwResult ComputeDtw(const Trajectory& reference, const Trajectory& source,
+                     const DtwOptions& options) {
+  const auto start = Clock::now();
+  const int n = static_cast<int>(reference.size());
+  const int big_n = static_cast<int>(source.size());
+  if (n == 0 || big_n == 0) {
+    ThrowBadValue("DTW", std::to_string(n) + " reference and " + std::to_string(big_n) +
+                             " source frames", "non-empty takes");
+  }
+  if (n == 1 && big_n > 1) {
+    ThrowBadValue("DTW", "a reference of 1 frame and a source of " + std::to_string(big_n),
+                  "a warp with w(0) = 0 and w(n-1) = N-1 (eq. 3), impossible for n = 1 < N");
+  }
+  if (options.step_pattern == StepPattern::kSlopeLimited && big_n - 1 > 2 * (n - 1)) {
+    ThrowBadValue("DTW (step_pattern slope_limited)",
+                  "a source of " + std::to_string(big_n) + " frames for a reference of " +
+                      std::to_string(n),
+                  "a source at most 2 (n - 1) + 1 frames long");
+  }
+  const PoseArrays ref(reference), src(source);
+  DtwResult result;
+  result.summary.cells_total = static_cast<std::int64_t>(n) * big_n;
+  std::int64_t evaluated = 0;
+  double cost = kInf;
+  switch (options.step_pattern) {
+    case StepPattern::kLiteral: {
+      // Small problems: the full programme is as fast as bounding it.
+      if (options.prune && static_cast<std::int64_t>(n) * big_n > 64 * 64) {
+        cost = PrunedLiteral(ref, src, options.lambda, &result.warp, &evaluated);
+      } else {
+        LiteralProgramme programme(ref, src, options.lambda);
+        cost = programme.Run(AllLive{}, &result.warp, &evaluated);
+      }
+      break;
+    }
+    case StepPattern::kSlopeLimited:
+      cost = SlopeLimited(ref, src, options.lambda, &result.warp, &evaluated);
+      break;
+    case StepPattern::kSymmetric:
+      cost = Symmetric(ref, src, options.lambda, &result.warp, &evaluated);
+      break;
+  }
+  result.summary.cost = cost;
+  result.summary.cells_evaluated = evaluated;
+  result.summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
+double WarpCost(const Trajectory& reference, const Trajectory& source, const std::vector<int>& warp,
+                double lambda) {
+  double cost = 0.0;
+  for (std::size_t t = 0; t < warp.size(); ++t) {
+    cost += MatchCost(reference.poses[t], source.poses[warp[t]], lambda);
+  }
+  return cost;
+}
+
+bool IsValidWarp(const std::vector<int>& warp, int source_frames, StepPattern pattern) {
+  if (warp.empty() || warp.front() != 0 || warp.back() != source_frames - 1) return false;
+  for (std::size_t t = 1; t < warp.size(); ++t) {
+    const int step = warp[t] - warp[t - 1];
+    if (step < 0 || warp[t] >= source_frames) return false;
+    if (pattern == StepPattern::kSlopeLimited && step > 2) return false;
+  }
+  return true;
+}
+
+}  // namespace mmh::montage

@@ -1,0 +1,136 @@
+#include "montage/smoothness.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+#include "montage/match_cost.h"
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define MMH_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define MMH_SIMD_CLONES
+#endif
+
+namespace mmh::montage {
+namespace {
+
+constexpr std::pair<WindowEdge, const char*> kEdgeNames[] = {
+    {WindowEdge::kScaledMean, "scaled_mean"},
+    {WindowEdge::kTruncatedSum, "truncated_sum"},
+};
+
+// Flat pose arrays of one take: [qx qy qz qw tx ty tz] as seven columns.
+struct Columns {
+  std::vector<double> v[7];
+  int size = 0;
+  explicit Columns(const Trajectory& take) : size(static_cast<int>(take.size())) {
+    for (auto& c : v) c.resize(size);
+    for (int i = 0; i < size; ++i) {
+      const auto& p = take.poses[i];
+      v[0][i] = p.rotation.x(), v[1][i] = p.rotation.y(), v[2][i] = p.rotation.z();
+      v[3][i] = p.rotation.w(), v[4][i] = p.translation.x(), v[5][i] = p.translation.y();
+      v[6][i] = p.translation.z();
+    }
+  }
+};
+
+// out[i] = C_match(l[a + i], k[b + i]) for i < count: one diagonal of eq. 9's window.
+MMH_SIMD_CLONES
+void DiagonalCosts(const Columns& l, int a, const Columns& k, int b, int count, double lambda,
+                   double* __restrict out) {
+  const double* __restrict ax = l.v[0].data() + a;
+  const double* __restrict ay = l.v[1].data() + a;
+  const double* __restrict az = l.v[2].data() + a;
+  const double* __restrict aw = l.v[3].data() + a;
+  const double* __restrict atx = l.v[4].data() + a;
+  const double* __restrict aty = l.v[5].data() + a;
+  const double* __restrict atz = l.v[6].data() + a;
+  const double* __restrict bx = k.v[0].data() + b;
+  const double* __restrict by = k.v[1].data() + b;
+  const double* __restrict bz = k.v[2].data() + b;
+  const double* __restrict bw = k.v[3].data() + b;
+  const double* __restrict btx = k.v[4].data() + b;
+  const double* __restrict bty = k.v[5].data() + b;
+  const double* __restrict btz = k.v[6].data() + b;
+  for (int i = 0; i < count; ++i) {
+    out[i] = MatchCost(ax[i], ay[i], az[i], aw[i], atx[i], aty[i], atz[i], bx[i], by[i], bz[i],
+                       bw[i], btx[i], bty[i], btz[i], lambda);
+  }
+}
+
+// Eq. 9 around centres cl (take l) and ck (take k, already w_k(t+1) - 1), over the valid part of
+// the window, summed in h order.
+double WindowCost(const Columns& l, int cl, const Columns& k, int ck,
+                  const SmoothnessOptions& options, double* scratch) {
+  const int h = options.half_window;
+  // Valid h: 0 <= cl + h < l.size and 0 <= ck + h < k.size.
+  const int lo = std::max({-h, -cl, -ck});
+  const int hi = std::min({h, l.size - 1 - cl, k.size - 1 - ck});
+  const int valid = hi - lo + 1;
+  if (valid <= 0) return 0.0;
+  DiagonalCosts(l, cl + lo, k, ck + lo, valid, options.lambda, scratch);
+  double sum = 0.0;
+  for (int i = 0; i < valid; ++i) sum += scratch[i];
+  if (options.window_edge == WindowEdge::kScaledMean && valid < 2 * h + 1) {
+    sum = sum / valid * (2 * h + 1);
+  }
+  return sum;
+}
+
+}  // namespace
+
+std::span<const std::pair<WindowEdge, const char*>> EnumNames(WindowEdge) { return kEdgeNames; }
+
+void SmoothnessOptions::Validate(const std::string& prefix) const {
+  if (!std::isfinite(lambda) || lambda < 0) {
+    ThrowBadValue(prefix + ".lambda", FormatNumber(lambda), "a finite number >= 0");
+  }
+  if (half_window < 0 || half_window > 1000) {
+    ThrowBadValue(prefix + ".half_window", std::to_string(half_window), "an integer in [0, 1000]");
+  }
+}
+
+TransitionCosts ComputeSmoothnessCosts(const std::vector<Trajectory>& takes,
+                                       const std::vector<std::vector<int>>& warps,
+                                       const SmoothnessOptions& options) {
+  const int m = static_cast<int>(takes.size());
+  const int n = warps.empty() ? 0 : static_cast<int>(warps[0].size());
+  TransitionCosts table;
+  table.frames = n;
+  table.takes = m;
+  table.values.assign(static_cast<std::size_t>(std::max(0, n - 1)) * m * m, 0.0);
+  std::vector<Columns> columns;
+  columns.reserve(m);
+  for (const auto& take : takes) columns.emplace_back(take);
+  // Rows are independent: the table is the same for any thread count.
+  tbb::parallel_for(tbb::blocked_range<int>(0, std::max(0, n - 1), 64),
+                    [&](const tbb::blocked_range<int>& range) {
+                      std::vector<double> scratch(2 * options.half_window + 1);
+                      for (int t = range.begin(); t < range.end(); ++t) {
+                        double* row = table.values.data() + static_cast<std::size_t>(t) * m * m;
+                        for (int l = 0; l < m; ++l) {
+                          for (int k = 0; k < m; ++k) {
+                            if (k == l) continue;
+                            row[l * m + k] = WindowCost(columns[l], warps[l][t], columns[k],
+                                                        warps[k][t + 1] - 1, options,
+                                                        scratch.data());
+                          }
+                        }
+                      }
+                    });
+  return table;
+}
+
+double SmoothnessCost(const Trajectory& take_l, const std::vector<int>& warp_l,
+                      const Trajectory& take_k, const std::vector<int>& warp_k, int t,
+                      const SmoothnessOptions& options) {
+  if (&take_l == &take_k) return 0.0;
+  const Columns l(take_l), k(take_k);
+  std::vector<double> scratch(2 * options.half_window + 1);
+  return WindowCost(l, warp_l[t], k, warp_k[t + 1] - 1, options, scratch.data());
+}
+
+}  // namespace mmh::montage

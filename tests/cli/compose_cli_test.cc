@@ -1,0 +1,182 @@
+// End-to-end tests of `mmh compose` as a user runs it: exit codes, messages naming the file,
+// line, key and value, no output on bad input, identical bytes on a rerun.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "core/annotation.h"
+#include "core/text_parsing.h"
+#include "core/tum_io.h"
+
+namespace mmh {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult RunMmh(const std::string& arguments) {
+  const std::string command = std::string(MMH_BINARY) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[512];
+  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WEXITSTATUS(status);
+  return result;
+}
+
+class ComposeCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("mmh_cli_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    for (int k = 0; k < 3; ++k) {
+      const int frames = 200 + 20 * k;
+      Trajectory take;
+      Annotation annotation;
+      for (int i = 0; i < frames; ++i) {
+        const double u = static_cast<double>(i) / (frames - 1);  // story progress
+        const double angle = 2 * M_PI * u;
+        take.timestamps.push_back(i / 30.0);
+        take.poses.emplace_back(
+            Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ())),
+            Eigen::Vector3d(0.3 * std::cos(angle) + noise(rng), 0.3 * std::sin(angle) + noise(rng),
+                            0.05));
+        annotation.timestamps.push_back(i / 30.0);
+        annotation.values.push_back(std::clamp(4.0 * std::sin(3 * angle + k), -5.0, 5.0));
+      }
+      WriteTum(dir_ / ("take_" + std::to_string(k) + ".tum"), take);
+      WriteAnnotationCsv(dir_ / ("take_" + std::to_string(k) + ".csv"), annotation);
+    }
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Inputs() const {
+    std::string s = "--takes";
+    for (int k = 0; k < 3; ++k) s += " " + (dir_ / ("take_" + std::to_string(k) + ".tum")).string();
+    s += " --annotations";
+    for (int k = 0; k < 3; ++k) s += " " + (dir_ / ("take_" + std::to_string(k) + ".csv")).string();
+    return s;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ComposeCliTest, WritesAllOutputsAndRerunGivesSameBytes) {
+  const fs::path out1 = dir_ / "out1", out2 = dir_ / "out2";
+  const auto r1 = RunMmh("compose " + Inputs() + " --out " + out1.string() + " --quiet");
+  ASSERT_EQ(r1.exit_code, 0) << r1.output;
+  const auto r2 = RunMmh("compose " + Inputs() + " --out " + out2.string() + " --threads 1 --quiet");
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  for (const char* name : {"montage.tum", "segments.csv", "timeline.csv", "config.resolved.json"}) {
+    ASSERT_TRUE(fs::exists(out1 / name)) << name;
+    EXPECT_EQ(ReadTextFile(out1 / name), ReadTextFile(out2 / name)) << name;
+  }
+  EXPECT_TRUE(fs::exists(out1 / "summary.json"));
+  EXPECT_TRUE(fs::exists(out1 / "run.json"));
+  const Trajectory montage = ReadTum(out1 / "montage.tum");
+  EXPECT_GT(montage.size(), 150u);
+  // The resolved config holds every default.
+  const std::string resolved = ReadTextFile(out1 / "config.resolved.json");
+  for (const char* key : {"\"mu\": 100.0", "\"min_segment_length\": 60", "\"lambda\": 2.5",
+                          "\"lambda\": 0.8", "\"window\": 15", "\"reaction_time\": 0.3"}) {
+    EXPECT_NE(resolved.find(key), std::string::npos) << key << "\n" << resolved;
+  }
+}
+
+TEST_F(ComposeCliTest, SetOverridesReachTheResolvedConfig) {
+  const fs::path out = dir_ / "out";
+  const auto r = RunMmh("compose " + Inputs() + " --out " + out.string() +
+                        " --quiet --set montage.labelling.min_segment_length=30"
+                        " --set montage.blend.weight=smoothstep");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string resolved = ReadTextFile(out / "config.resolved.json");
+  EXPECT_NE(resolved.find("\"min_segment_length\": 30"), std::string::npos);
+  EXPECT_NE(resolved.find("\"weight\": \"smoothstep\""), std::string::npos);
+}
+
+struct BadCase {
+  std::string name;
+  std::string extra;                // appended arguments
+  std::vector<std::string> expect;  // substrings of the message
+};
+
+TEST_F(ComposeCliTest, BadInputExitsTwoNamesTheProblemAndWritesNothing) {
+  // Files with defects.
+  std::ofstream(dir_ / "nan.tum") << "0 0 0 0 0 0 0 1\n0.1 nan 0 0 0 0 0 1\n";
+  std::ofstream(dir_ / "zero_q.tum") << "0 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 0\n";
+  std::ofstream(dir_ / "empty.tum") << "# nothing\n";
+  std::ofstream(dir_ / "config.json") << "{\"montage\": {\"labelling\": {\"mu\": 100, \"dd\": 3}}}";
+  std::ofstream(dir_ / "broken.json") << "{\"montage\": {\n  \"mu\": ,\n}}";
+  const std::string t0 = (dir_ / "take_0.tum").string();
+  const std::string a0 = (dir_ / "take_0.csv").string();
+  const std::string a1 = (dir_ / "take_1.csv").string();
+  const std::vector<BadCase> cases = {
+      {"misspelt key", Inputs() + " --set montage.labelling.mu_=3",
+       {"montage.labelling.mu_", "unknown", "did you mean 'mu'"}},
+      {"wrong type", Inputs() + " --set montage.dtw.lambda=\\\"x\\\"",
+       {"montage.dtw.lambda", "\"x\"", "a number"}},
+      {"out of range", Inputs() + " --set montage.blend.window=14",
+       {"montage.blend.window", "14", "odd"}},
+      {"unknown enum", Inputs() + " --set montage.dtw.step_pattern=diagonal",
+       {"montage.dtw.step_pattern", "diagonal", "literal"}},
+      {"unknown key in file", Inputs() + " --config " + (dir_ / "config.json").string(),
+       {"config.json", "montage.labelling.dd", "unknown"}},
+      {"invalid json", Inputs() + " --config " + (dir_ / "broken.json").string(),
+       {"broken.json:2:"}},
+      {"one take", "--takes " + t0 + " --annotations " + a0, {"at least 2 takes"}},
+      {"annotation count", "--takes " + t0 + " " + t0 + " --annotations " + a0,
+       {"--annotations", "1 files for 2 takes"}},
+      {"length mismatch", "--takes " + t0 + " " + t0 + " --annotations " + a0 + " " + a1,
+       {"take_1.csv", "220 rows", "200 rows"}},
+      {"nan pose", "--takes " + t0 + " " + (dir_ / "nan.tum").string() + " --annotations " + a0 +
+                       " " + a0,
+       {"nan.tum:2", "tx", "'nan'"}},
+      {"zero quaternion", "--takes " + t0 + " " + (dir_ / "zero_q.tum").string() +
+                              " --annotations " + a0 + " " + a0,
+       {"zero_q.tum:2", "zero quaternion"}},
+      {"empty file", "--takes " + t0 + " " + (dir_ / "empty.tum").string() + " --annotations " +
+                         a0 + " " + a0,
+       {"empty.tum", "no poses"}},
+      {"missing file", "--takes " + t0 + " /nonexistent/x.tum --annotations " + a0 + " " + a0,
+       {"/nonexistent/x.tum", "does not exist"}},
+      {"take shorter than d", Inputs() + " --set montage.labelling.min_segment_length=250",
+       {"take_0.tum", "200 frames", "more than montage.labelling.min_segment_length = 250"}},
+      {"unknown flag", Inputs() + " --bogus", {"bogus"}},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = dir_ / ("out_" + std::to_string(&c - cases.data()));
+    const auto r = RunMmh("compose " + c.extra + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << c.name << "\n" << r.output;
+    for (const auto& e : c.expect) {
+      EXPECT_NE(r.output.find(e), std::string::npos) << c.name << ": '" << e << "' not in\n"
+                                                     << r.output;
+    }
+    EXPECT_FALSE(fs::exists(out / "montage.tum")) << c.name;
+  }
+}
+
+TEST_F(ComposeCliTest, UnwritableOutputIsAnInputError) {
+  std::ofstream(dir_ / "file") << "x";
+  const auto r = RunMmh("compose " + Inputs() + " --out " + (dir_ / "file" / "sub").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("file/sub"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace mmh
