@@ -31,7 +31,7 @@ Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
     if (content.empty()) continue;
     const std::string where = path.string() + ":" + std::to_string(line_number);
     if (!header_seen) {
-      const auto names = SplitFields(content, ",");
+      const auto names = SplitCsvFields(content);
       if (names.size() != 2 || Trim(names[0]) != "timestamp" || Trim(names[1]) != "value") {
         ThrowBadValue(where, "the header '" + std::string(content) + "'",
                       "the header 'timestamp,value'");
@@ -39,7 +39,7 @@ Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
       header_seen = true;
       continue;
     }
-    const auto fields = SplitFields(content, ",");
+    const auto fields = SplitCsvFields(content);
     if (fields.size() != 2) {
       ThrowBadValue(where, std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
                     "2 fields: timestamp,value");
@@ -86,6 +86,9 @@ void ValidateAnnotation(const Annotation& annotation, const std::string& name) {
 
 void WriteAnnotationCsv(const std::filesystem::path& path, const Annotation& annotation) {
   ValidateAnnotation(annotation, path.string());
+  if (annotation.values.empty()) {
+    ThrowBadValue(path.string(), "an empty annotation", "at least one row (the reader rejects none)");
+  }
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "timestamp,value\n";
     for (std::size_t i = 0; i < annotation.size(); ++i) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -13,8 +14,10 @@ namespace mmh {
 
 void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write) {
+  // Unique per process and call, so that concurrent writers never share a temporary.
+  static std::atomic<unsigned> counter{0};
   std::filesystem::path temporary = path;
-  temporary += ".tmp." + std::to_string(::getpid());
+  temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
   try {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out) {

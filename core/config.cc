@@ -11,6 +11,8 @@ Config Config::Load(const std::filesystem::path& path) {
   config.file_ = path.string();
   try {
     config.root_ = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::out_of_range& e) {
+    throw InputError(path.string() + ": a number out of range (" + e.what() + ")");
   } catch (const nlohmann::json::parse_error& e) {
     // Byte offset -> line and column.
     std::size_t line = 1, column = 1;
@@ -42,6 +44,8 @@ void Config::Set(const std::string& assignment) {
   nlohmann::json value;
   try {
     value = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::out_of_range&) {
+    ThrowBadValue("--set " + assignment, "'" + text + "'", "a number a double can hold");
   } catch (const nlohmann::json::parse_error&) {
     value = text;
   }

@@ -13,6 +13,7 @@
 // floating point, std::string, enums with an EnumNames(E) overload, and nested Options structs.
 #pragma once
 
+#include <cmath>
 #include <concepts>
 #include <cstdint>
 #include <limits>
@@ -116,18 +117,36 @@ void ReadValue(const nlohmann::json& value, const std::string& key, const Config
     if (!value.is_boolean()) ThrowKeyError(source, key, value, "true or false");
     *field = value.get<bool>();
   } else if constexpr (std::is_integral_v<T>) {
-    if (value.is_number_integer()) {
+    // Unsigned and signed JSON integers are range-checked separately: no wrap-around.
+    if (value.is_number_unsigned()) {
+      const auto v = value.get<std::uint64_t>();
+      if (v <= static_cast<std::uint64_t>(std::numeric_limits<T>::max())) {
+        *field = static_cast<T>(v);
+        return;
+      }
+    } else if (value.is_number_integer()) {
       const auto v = value.get<std::int64_t>();
-      if (v >= static_cast<std::int64_t>(std::numeric_limits<T>::min()) &&
-          v <= static_cast<std::int64_t>(std::numeric_limits<T>::max())) {
+      const bool fits =
+          std::is_signed_v<T>
+              ? v >= static_cast<std::int64_t>(std::numeric_limits<T>::min()) &&
+                    v <= static_cast<std::int64_t>(std::numeric_limits<T>::max())
+              : v >= 0 && static_cast<std::uint64_t>(v) <=
+                              static_cast<std::uint64_t>(std::numeric_limits<T>::max());
+      if (fits) {
         *field = static_cast<T>(v);
         return;
       }
     }
-    ThrowKeyError(source, key, value, "an integer");
+    ThrowKeyError(source, key, value,
+                  "an integer in [" + std::to_string(std::numeric_limits<T>::min()) + ", " +
+                      std::to_string(std::numeric_limits<T>::max()) + "]");
   } else if constexpr (std::is_floating_point_v<T>) {
     if (!value.is_number()) ThrowKeyError(source, key, value, "a number");
-    *field = value.get<T>();
+    const double v = value.get<double>();
+    if (!(std::abs(v) <= static_cast<double>(std::numeric_limits<T>::max()))) {
+      ThrowKeyError(source, key, value, "a finite number of this field's precision");
+    }
+    *field = static_cast<T>(v);
   } else if constexpr (std::is_same_v<T, std::string>) {
     if (!value.is_string()) ThrowKeyError(source, key, value, "a string");
     *field = value.get<std::string>();

@@ -12,8 +12,9 @@ Rigid3 Interpolate(const Rigid3& from, const Rigid3& to, double weight) {
 }
 
 double RotationAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
-  const double dot = std::min(1.0, std::abs(a.dot(b)));
-  return 2.0 * std::acos(dot);
+  // 2 atan2(|v|, |w|) of a^-1 b keeps full precision for tiny angles (2 acos(|a.b|) does not).
+  const Eigen::Quaterniond d = a.conjugate() * b;
+  return 2.0 * std::atan2(d.vec().norm(), std::abs(d.w()));
 }
 
 }  // namespace mmh

@@ -14,6 +14,9 @@ std::string ReadTextFile(const std::filesystem::path& path);
 // Splits on any run of the given delimiter characters, dropping empty fields.
 std::vector<std::string_view> SplitFields(std::string_view line, std::string_view delimiters);
 
+// Splits a CSV line on every comma, keeping empty fields ("a,,b" has three fields).
+std::vector<std::string_view> SplitCsvFields(std::string_view line);
+
 // Parses a complete double (no trailing characters); false if it is not one.
 bool ParseDouble(std::string_view text, double* value);
 

@@ -42,7 +42,9 @@ Trajectory ReadTum(const std::filesystem::path& path) {
       ThrowBadValue(where + ", quaternion norm", FormatNumber(norm),
                     "a unit quaternion (norm within 1 \u00b1 0.01)");
     }
-    q.normalize();
+    // Only when needed: normalising a quaternion that is already unit to the last bits would change
+    // those bits, and reading then writing a file must give it back unchanged.
+    if (std::abs(norm - 1.0) > 1e-12) q.normalize();
     if (!trajectory.timestamps.empty() && !(v[0] > trajectory.timestamps.back())) {
       ThrowBadValue(where + ", timestamp", FormatNumber(v[0]),
                     "greater than the previous timestamp " +
@@ -60,6 +62,9 @@ Trajectory ReadTum(const std::filesystem::path& path) {
 void WriteTum(const std::filesystem::path& path, const Trajectory& trajectory,
               const std::string& comment) {
   ValidateTrajectory(trajectory, path.string());
+  if (trajectory.empty()) {
+    ThrowBadValue(path.string(), "an empty trajectory", "at least one pose (ReadTum rejects none)");
+  }
   WriteFileAtomically(path, [&](std::ostream& out) {
     if (!comment.empty()) {
       std::istringstream lines(comment);

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <cstdio>
+#include <cstdlib>
 
 #include "core/error.h"
 #include "montage/match_cost.h"
@@ -22,14 +24,19 @@ namespace mmh::montage {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Pruning granularity: blocks of 16 source frames (four blocks per 64-bit backtracking word).
-constexpr int kBlock = 16;
+// Pruning granularity: blocks of kBlock source frames (64 / kBlock per backtracking word).
+#ifndef MMH_DTW_BLOCK
+#define MMH_DTW_BLOCK 16
+#endif
+constexpr int kBlock = MMH_DTW_BLOCK;
+constexpr int kBlocksPerWord = 64 / kBlock;
 
 using Clock = std::chrono::steady_clock;
 
 // Poses as structure of arrays, so that the cost loops vectorise.
 struct PoseArrays {
   std::vector<double> qx, qy, qz, qw, tx, ty, tz;
+  PoseArrays() = default;
   explicit PoseArrays(const Trajectory& trajectory) {
     const std::size_t n = trajectory.size();
     for (auto* v : {&qx, &qy, &qz, &qw, &tx, &ty, &tz}) v->resize(n);
@@ -119,29 +126,42 @@ BlockBalls MakeBlockBalls(const PoseArrays& src) {
   return b;
 }
 
-// out[j] = lower bound of C_match(reference frame t, any source frame of block j).
+// Lower bound of C_match(reference frame t, any source frame of block j).
+inline double BlockLowerBound(const PoseArrays& ref, int t, const BlockBalls& b, int j,
+                              double lambda) {
+  const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
+  const double dx = ax - b.cx[j], dy = ay - b.cy[j], dz = az - b.cz[j], dw = aw - b.cw[j];
+  const double sx = ax + b.cx[j], sy = ay + b.cy[j], sz = az + b.cz[j], sw = aw + b.cw[j];
+  const double q = std::sqrt(
+      std::min(dx * dx + dy * dy + dz * dz + dw * dw, sx * sx + sy * sy + sz * sz + sw * sw));
+  const double ex = ref.tx[t] - b.mx[j], ey = ref.ty[t] - b.my[j], ez = ref.tz[t] - b.mz[j];
+  const double x = std::sqrt(ex * ex + ey * ey + ez * ez);
+  return (std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j])) * (1 - 1e-9);
+}
+
+// out[j] = BlockLowerBound(ref, t, b, j, lambda) for j in
+// [first, last).
 MMH_SIMD_CLONES
-void LowerBoundRow(const PoseArrays& ref, int t, const BlockBalls& b, int blocks, double lambda,
-                   double* __restrict out) {
+void LowerBoundRow(const PoseArrays& ref, int t, const BlockBalls& b, int first, int last,
+                   double lambda, double* __restrict out) {
   const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
   const double atx = ref.tx[t], aty = ref.ty[t], atz = ref.tz[t];
-  for (int j = 0; j < blocks; ++j) {
+  // The same formula as BlockLowerBound, written out so that it vectorises.
+  for (int j = first; j < last; ++j) {
     const double dx = ax - b.cx[j], dy = ay - b.cy[j], dz = az - b.cz[j], dw = aw - b.cw[j];
     const double sx = ax + b.cx[j], sy = ay + b.cy[j], sz = az + b.cz[j], sw = aw + b.cw[j];
     const double q = std::sqrt(std::min(dx * dx + dy * dy + dz * dz + dw * dw,
                                         sx * sx + sy * sy + sz * sz + sw * sw));
     const double ex = atx - b.mx[j], ey = aty - b.my[j], ez = atz - b.mz[j];
     const double x = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const double lb = std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j]);
-    out[j] = lb * (1 - 1e-9);
+    out[j] = (std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j])) * (1 - 1e-9);
   }
 }
 
-// Largest float not above x (x >= 0 or +inf).
-float FloatBelow(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return f;
+// out[i] = a float not above x[i] (x[i] >= 0 or +inf): shrinking by 2^-20 first leaves room for
+// the conversion's rounding (at most 2^-24 relative).
+void StoreBelow(const double* x, int count, float* out) {
+  for (int i = 0; i < count; ++i) out[i] = static_cast<float>(x[i] * (1.0 - 0x1p-20));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -157,64 +177,82 @@ class LiteralProgramme {
       : ref_(ref), src_(src), lambda_(lambda), n_(ref.size()), big_n_(src.size()),
         blocks_((big_n_ + kBlock - 1) / kBlock), words_((big_n_ + 63) / 64) {}
 
-  // `live(t, j)` says whether block j of row t may hold an optimal cell. Returns the cost (inf if
-  // no warp runs through live cells only) and fills `warp`.
-  template <class Live>
-  double Run(const Live& live, std::vector<int>* warp, std::int64_t* evaluated) {
+  // `range(t)` gives the blocks [first, last] of row t worth visiting (blocks outside are +inf);
+  // `live(t, j, m)` says whether block j of row t may hold an optimal cell, given m = M(t-1, end of
+  // block j), the least prefix minimum of the previous row over the block. Returns the cost (inf
+  // if no warp runs through live cells only) and fills `warp`.
+  template <class Range, class Live>
+  double Run(const Range& range, const Live& live, std::vector<int>* warp,
+             std::int64_t* evaluated) {
     bits_.assign(static_cast<std::size_t>(n_) * words_, 0);
-    std::vector<double> m_prev(big_n_), m_cur(big_n_);
-    std::vector<double> end_prev(blocks_, kInf), end_cur(blocks_, kInf);
-    std::vector<char> live_prev(blocks_, 0), live_cur(blocks_, 0);
+    m_prev_.resize(big_n_);
+    m_cur_.resize(big_n_);
+    end_prev_.assign(blocks_, kInf);
+    end_cur_.assign(blocks_, kInf);
+    live_prev_.assign(blocks_, 0);
+    live_cur_.assign(blocks_, 0);
     std::array<double, kBlock> cost{};
     double last_f = kInf;  // F(n-1, N-1)
 
-    // Row 0: only w(0) = 0 is allowed.
-    {
-      const double c = Cost(0, 0, cost.data());
-      ++*evaluated;
-      m_prev[0] = c;
-      bits_[0] = 1;
-      // Every other cell of row 0 is +inf, so the prefix minimum stays c along the row.
-      for (int j = 0; j < blocks_; ++j) end_prev[j] = c;
-      std::fill(live_prev.begin(), live_prev.end(), 0);
-      live_prev[0] = 1;
-      for (int s = 1; s < std::min(big_n_, kBlock); ++s) m_prev[s] = c;
-      if (n_ == 1) last_f = big_n_ == 1 ? c : kInf;
-    }
+    // Row 0: only w(0) = 0 is allowed; the prefix minimum is C(0, 0) along the whole row.
+    const double c0 = Cost(0, 0, cost.data());
+    ++*evaluated;
+    for (int s = 0; s < std::min(big_n_, kBlock); ++s) m_prev_[s] = c0;
+    end_prev_[0] = c0;
+    live_prev_[0] = 1;
+    bits_[0] = 1;
+    int prev_first = 0, prev_last = 0;  // visited blocks of the previous row
+    double prev_tail = c0;               // its prefix minimum after prev_last
+    if (n_ == 1) last_f = big_n_ == 1 ? c0 : kInf;
+
     for (int t = 1; t < n_; ++t) {
+      auto [first_block, last_block] = range(t);
+      // Below the previous row's first visited block every cell of row t-1 is +inf.
+      first_block = std::max(first_block, prev_first);
       double carry = kInf;  // prefix minimum of row t so far
       std::uint64_t* row_bits = bits_.data() + static_cast<std::size_t>(t) * words_;
-      for (int j = 0; j < blocks_; ++j) {
+      auto end_of_prev = [&](int j) {
+        return j < prev_first ? kInf : (j > prev_last ? prev_tail : end_prev_[j]);
+      };
+      for (int j = first_block; j <= last_block; ++j) {
         const int first = j * kBlock;
         const int count = std::min(kBlock, big_n_ - first);
-        const double before = j == 0 ? kInf : end_prev[j - 1];
-        // Unreachable from row t-1, or pruned: all +inf.
-        if (!live(t, j) || (!live_prev[j] && before == kInf)) {
-          live_cur[j] = 0;
-          end_cur[j] = carry;
+        const bool prev_live = j >= prev_first && j <= prev_last && live_prev_[j];
+        const double before = j == 0 ? kInf : end_of_prev(j - 1);
+        if ((!prev_live && before == kInf) || !live(t, j, end_of_prev(j))) {
+          live_cur_[j] = 0;
+          end_cur_[j] = carry;
           continue;
         }
         CostRun(ref_, t, src_, first, count, lambda_, cost.data());
         *evaluated += count;
-        std::uint64_t mask = 0;
-        const double* prev = m_prev.data() + first;
-        double* cur = m_cur.data() + first;
-        for (int i = 0; i < count; ++i) {
-          const double f = cost[i] + (live_prev[j] ? prev[i] : before);
-          if (f < carry) {
-            carry = f;
-            mask |= std::uint64_t{1} << i;
-          }
-          cur[i] = carry;
-          if (t == n_ - 1 && first + i == big_n_ - 1) last_f = f;
+        if (prev_live) {
+          const double* prev = m_prev_.data() + first;
+          for (int i = 0; i < count; ++i) cost[i] += prev[i];
+        } else {
+          for (int i = 0; i < count; ++i) cost[i] += before;
         }
-        row_bits[j / 4] |= mask << (16 * (j % 4));
-        live_cur[j] = 1;
-        end_cur[j] = carry;
+        std::uint64_t mask = 0;
+        double* cur = m_cur_.data() + first;
+        for (int i = 0; i < count; ++i) {
+          const double f = cost[i];
+          const bool lower = f < carry;
+          carry = lower ? f : carry;
+          mask |= static_cast<std::uint64_t>(lower) << i;
+          cur[i] = carry;
+        }
+        if (t == n_ - 1 && first + count == big_n_) last_f = cost[count - 1];
+        row_bits[j / kBlocksPerWord] |= mask << (kBlock * (j % kBlocksPerWord));
+        live_cur_[j] = 1;
+        end_cur_[j] = carry;
       }
-      std::swap(m_prev, m_cur);
-      std::swap(end_prev, end_cur);
-      std::swap(live_prev, live_cur);
+      std::swap(m_prev_, m_cur_);
+      std::swap(end_prev_, end_cur_);
+      std::swap(live_prev_, live_cur_);
+      prev_first = first_block;
+      prev_last = std::max(last_block, first_block - 1);
+      prev_tail = carry;
+      if (carry == kInf) return kInf;  // nothing of row t is reachable
     }
     if (!(last_f < kInf)) return kInf;
     warp->assign(n_, 0);
@@ -245,86 +283,118 @@ class LiteralProgramme {
   double lambda_;
   int n_, big_n_, blocks_, words_;
   std::vector<std::uint64_t> bits_;
+  std::vector<double> m_prev_, m_cur_, end_prev_, end_cur_;
+  std::vector<char> live_prev_, live_cur_;
 };
 
 struct AllLive {
-  bool operator()(int, int) const { return true; }
+  bool operator()(int, int, double) const { return true; }
+};
+struct AllBlocks {
+  int blocks;
+  std::pair<int, int> operator()(int) const { return {0, blocks - 1}; }
 };
 
-// The pruned literal DTW. Lower bounds:
-//   FL(t, j) <= min_{s in j} F(t, s): FL(t, j) = lb(t, j) + min_{j' <= j} FL(t-1, j'),
-//   BL(t, j) <= cost of rows t+1..n-1 after any s in j: BL(t, j) = min_{j' >= j} lb(t+1, j') +
-//   BL(t+1, j'), BL(n-1, last) = 0,
-// so every cell of an optimal warp has P(t, j) = FL + BL <= optimum <= U for any feasible cost U.
-// U comes from the programme restricted to a monotone band around the rows' least P; the exact
-// programme then runs over the blocks with P <= U. Both hold the optimum's cells, so the result is
-// the full programme's, warp for warp (the first-minimum tie rule sees the same candidates).
+// The pruned literal DTW, exact. With lb(t, j) <= C(t, s) for s in block j (BlockBalls) and the
+// backward bound
+//   BL(t, j) <= cost of rows t+1..n-1 after any s in block j:
+//   BL(n-1, last block) = 0, BL(t, j) = min_{j' >= j} lb(t+1, j') + BL(t+1, j'),
+// a cell (t, s) of block j can only lie on a warp of cost <= U if
+//   lb(t, j) + M(t-1, end of block j) + BL(t, j) <= U,
+// where M(t-1, .) is the programme's own prefix minimum of the previous row (exact on every
+// optimal warp's cells, by induction over t). U is the cost of a feasible warp: the literal
+// programme on every 8th frame, refined in a band of +-24 frames around it. Every optimal warp
+// keeps all its cells live, and so does every first-minimum backtracking candidate, so the result
+// is the full programme's, warp for warp.
 double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda,
                      std::vector<int>* warp, std::int64_t* evaluated) {
   const int n = ref.size(), big_n = src.size();
   const int blocks = (big_n + kBlock - 1) / kBlock;
   const BlockBalls balls = MakeBlockBalls(src);
-  // lb(t, j) and then P(t, j) as floats rounded down: #n by #blocks.
-  std::vector<float> lb(static_cast<std::size_t>(n) * blocks);
-  std::vector<float> p(static_cast<std::size_t>(n) * blocks);
-  std::vector<double> row(blocks), acc(blocks);
+
+  // 1. Upper bound U: a coarse warp on every kCoarse-th frame (both ends kept), then the exact
+  // programme in a band of +-kRadius frames around it.
+  constexpr int kCoarse = 8, kRadius = 24;
+  auto subsample = [](int frames) {
+    std::vector<int> index;
+    for (int i = 0; i < frames - 1; i += kCoarse) index.push_back(i);
+    index.push_back(frames - 1);
+    return index;
+  };
+  auto pick = [](const PoseArrays& from, const std::vector<int>& index) {
+    PoseArrays out;
+    for (auto* v : {&out.qx, &out.qy, &out.qz, &out.qw, &out.tx, &out.ty, &out.tz}) {
+      v->resize(index.size());
+    }
+    for (std::size_t i = 0; i < index.size(); ++i) {
+      out.qx[i] = from.qx[index[i]], out.qy[i] = from.qy[index[i]];
+      out.qz[i] = from.qz[index[i]], out.qw[i] = from.qw[index[i]];
+      out.tx[i] = from.tx[index[i]], out.ty[i] = from.ty[index[i]];
+      out.tz[i] = from.tz[index[i]];
+    }
+    return out;
+  };
+  const std::vector<int> ref_index = subsample(n), src_index = subsample(big_n);
+  const PoseArrays coarse_ref = pick(ref, ref_index), coarse_src = pick(src, src_index);
+  std::vector<int> coarse_warp;  // n >= 2 here, so both subsamples have >= 2 frames
+  LiteralProgramme coarse(coarse_ref, coarse_src, lambda);
+  coarse.Run(AllBlocks{(coarse_src.size() + kBlock - 1) / kBlock}, AllLive{}, &coarse_warp, evaluated);
+  std::vector<int> band_first(n), band_last(n);
   for (int t = 0; t < n; ++t) {
-    LowerBoundRow(ref, t, balls, blocks, lambda, row.data());
-    float* out = lb.data() + static_cast<std::size_t>(t) * blocks;
-    for (int j = 0; j < blocks; ++j) out[j] = FloatBelow(row[j]);
+    const int i =
+        std::min(static_cast<int>(ref_index.size()) - 1, (t + kCoarse / 2) / kCoarse);
+    const int centre = src_index[coarse_warp[i]];
+    band_first[t] = std::max(0, centre - kRadius) / kBlock;
+    band_last[t] = std::min(big_n - 1, centre + kRadius) / kBlock;
   }
-  // Backward bounds into p.
-  for (int j = 0; j < blocks; ++j) acc[j] = j == blocks - 1 ? 0.0 : kInf;
-  for (int t = n - 1; t >= 0; --t) {
-    float* out = p.data() + static_cast<std::size_t>(t) * blocks;
-    for (int j = 0; j < blocks; ++j) out[j] = FloatBelow(acc[j]);
-    if (t == 0) break;
-    const float* l = lb.data() + static_cast<std::size_t>(t) * blocks;
-    double suffix = kInf;
-    for (int j = blocks - 1; j >= 0; --j) {
-      suffix = std::min(suffix, static_cast<double>(l[j]) + acc[j]);
-      acc[j] = suffix;
-    }
-  }
-  // Forward bounds, added into p.
-  for (int j = 0; j < blocks; ++j) acc[j] = j == 0 ? static_cast<double>(lb[0]) : kInf;
-  std::vector<int> centre(n, 0);
-  for (int t = 0; t < n; ++t) {
-    const float* l = lb.data() + static_cast<std::size_t>(t) * blocks;
-    if (t > 0) {
-      double prefix = kInf;
-      for (int j = 0; j < blocks; ++j) {
-        prefix = std::min(prefix, acc[j]);
-        acc[j] = static_cast<double>(l[j]) + prefix;
-      }
-    }
-    float* out = p.data() + static_cast<std::size_t>(t) * blocks;
-    float best = std::numeric_limits<float>::infinity();
-    for (int j = 0; j < blocks; ++j) {
-      out[j] = FloatBelow(static_cast<double>(out[j]) + acc[j]);
-      if (out[j] < best) {
-        best = out[j];
-        centre[t] = j;
-      }
-    }
-  }
-  // Upper bound from a monotone band of +-2 blocks around the running maximum of the rows' least
-  // P; it always holds a warp (stay at the band's first frame), so U is finite.
-  for (int t = 1; t < n; ++t) centre[t] = std::max(centre[t], centre[t - 1]);
-  centre[n - 1] = blocks - 1;
+  // The band's first blocks must not decrease (then staying on them is a warp) and the last row
+  // must reach the last block.
+  for (int t = 1; t < n; ++t) band_first[t] = std::max(band_first[t], band_first[t - 1]);
+  for (int t = 0; t < n; ++t) band_last[t] = std::max(band_last[t], band_first[t]);
+  band_last[n - 1] = blocks - 1;
   LiteralProgramme programme(ref, src, lambda);
   std::vector<int> band_warp;
   const double upper = programme.Run(
-      [&](int t, int j) { return j >= centre[t] - 2 && j <= centre[t] + 2; }, &band_warp,
+      [&](int t) { return std::make_pair(band_first[t], band_last[t]); }, AllLive{}, &band_warp,
       evaluated);
   // Margin for the rounding of the bounds' sums.
   const double threshold = upper * (1 + 1e-9) + 1e-9;
+
+  // 2. Backward bounds BL(t, j), as floats rounded down (#n by #blocks). BL is non-decreasing in
+  // j, so blocks past last_useful[t] (BL > U) are dead, and the terms they feed into row t-1 are
+  // > U as well: each row only needs the blocks up to the next row's last useful one.
+  std::vector<float> backward(static_cast<std::size_t>(n) * blocks);
+  std::vector<int> last_useful(n, blocks - 1);
+  std::vector<double> lb_row(blocks), acc(blocks, kInf);
+  acc[blocks - 1] = 0.0;
+  for (int t = n - 1; t >= 0; --t) {
+    const int limit = last_useful[t];
+    StoreBelow(acc.data(), limit + 1, backward.data() + static_cast<std::size_t>(t) * blocks);
+    if (t == 0) break;
+    LowerBoundRow(ref, t, balls, 0, limit + 1, lambda, lb_row.data());
+    double suffix = kInf;
+    for (int j = limit; j >= 0; --j) {
+      suffix = std::min(suffix, lb_row[j] + acc[j]);
+      acc[j] = suffix;
+    }
+    int last = limit;
+    while (last > 0 && !(acc[last] <= threshold)) --last;
+    last_useful[t - 1] = last;
+  }
+
+  // 3. The exact programme over the blocks that may hold an optimal cell.
   const double cost = programme.Run(
-      [&](int t, int j) { return p[static_cast<std::size_t>(t) * blocks + j] <= threshold; }, warp,
-      evaluated);
+      [&](int t) { return std::make_pair(0, last_useful[t]); },
+      [&](int t, int j, double before_end) {
+        const double bound =
+            before_end + static_cast<double>(backward[static_cast<std::size_t>(t) * blocks + j]);
+        if (!(bound <= threshold)) return false;
+        return bound + BlockLowerBound(ref, t, balls, j, lambda) <= threshold;
+      },
+      warp, evaluated);
   if (cost < kInf) return cost;
   // Unreachable by the argument above; kept so that a bound bug can never lose the warp.
-  return programme.Run(AllLive{}, warp, evaluated);
+  return programme.Run(AllBlocks{blocks}, AllLive{}, warp, evaluated);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -383,7 +453,8 @@ double Symmetric(const PoseArrays& ref, const PoseArrays& src, double lambda,
     std::swap(prev, cur);
   }
   *evaluated += static_cast<std::int64_t>(n) * big_n;
-  // Walk back; w(t) = the smallest s of the path in row t.
+  // Walk back; w(t) = the smallest s of the path in row t, and w(n-1) = N-1 (eq. 3), so that the
+  // annotation warp (eq. 6) sees every source frame.
   warp->assign(n, 0);
   int t = n - 1, s = big_n - 1;
   while (t > 0 || s > 0) {
@@ -394,6 +465,7 @@ double Symmetric(const PoseArrays& ref, const PoseArrays& src, double lambda,
     else --s;
   }
   (*warp)[0] = 0;
+  (*warp)[n - 1] = big_n - 1;
   return prev[big_n - 1];
 }
 
@@ -446,7 +518,7 @@ DtwResult ComputeDtw(const Trajectory& reference, const Trajectory& source,
         cost = PrunedLiteral(ref, src, options.lambda, &result.warp, &evaluated);
       } else {
         LiteralProgramme programme(ref, src, options.lambda);
-        cost = programme.Run(AllLive{}, &result.warp, &evaluated);
+        cost = programme.Run(AllBlocks{(src.size() + kBlock - 1) / kBlock}, AllLive{}, &result.warp, &evaluated);
       }
       break;
     }

@@ -26,7 +26,8 @@ enum class StepPattern {
   // N - 1 <= 2 (n - 1).
   kSlopeLimited,
   // The classic symmetric DTW of Myers & Rabiner: a path of cells with steps (1,0), (0,1), (1,1),
-  // cost summed over every cell of the path; w(t) is the first source frame the path matches to t.
+  // cost summed over every cell of the path; w(t) is the first source frame the path matches to t
+  // for t < n-1, and w(n-1) = N-1.
   kSymmetric,
 };
 std::span<const std::pair<StepPattern, const char*>> EnumNames(StepPattern);
@@ -54,7 +55,9 @@ struct DtwOptions {
 struct DtwSummary {
   // Cost of the returned warp (eq. 4 sum, or the path sum for kSymmetric).
   double cost = 0.0;
-  // Cells of the n by N cost matrix whose C_match was evaluated, and n * N.
+  // C_match evaluations over all passes (the pruned programme runs a coarse pass, a band pass and
+  // the exact pass, so on unrelated takes, where nothing can be pruned, this can exceed n * N),
+  // and n * N, the full programme's count.
   std::int64_t cells_evaluated = 0;
   std::int64_t cells_total = 0;
   // Wall time in seconds.

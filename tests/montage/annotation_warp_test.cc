@@ -110,6 +110,19 @@ TEST(AnnotationWarp, HandWorkedSkip) {
   EXPECT_EQ(WarpAnnotation(a, w, AnnotationWarpForm::kPaperLiteral), expected);
 }
 
+// Hand-worked, a flat run followed by a skip: a = [1, 2, 3, 4] (N = 4), w = [0, 0, 3] (n = 3).
+// Conserving: the run t = 0, 1 shares a0 (0.5 each); the skipped frames 1, 2 go to the run's last
+// frame t = 1 (the frame just before the skip): t1 = 0.5 + 2 + 3 = 5.5; t2 = a3 = 4.
+// Literal: t0 (flat) = a0/2 = 0.5; t1 = sum_{0}^{2} a = 6; t2 = 4.
+TEST(AnnotationWarp, HandWorkedFlatThenSkip) {
+  const std::vector<double> a = {1, 2, 3, 4};
+  const std::vector<int> w = {0, 0, 3};
+  EXPECT_EQ(WarpAnnotation(a, w, AnnotationWarpForm::kConserving),
+            (std::vector<double>{0.5, 5.5, 4}));
+  EXPECT_EQ(WarpAnnotation(a, w, AnnotationWarpForm::kPaperLiteral),
+            (std::vector<double>{0.5, 6, 4}));
+}
+
 TEST(AnnotationWarp, ConservingConservesSumAndMatchesOracle) {
   std::mt19937_64 rng(13);
   std::uniform_real_distribution<double> u(-5, 5);

@@ -187,6 +187,34 @@ TEST(LabellingBruteForce, MatchesExhaustiveEnumeration) {
   EXPECT_GT(checked_infeasible, 100);
 }
 
+// Longer two-take instances (up to 2^13 labellings each), where several segments fit.
+TEST(LabellingBruteForce, LongerTwoTakeInstances) {
+  std::mt19937_64 rng(1998);
+  for (int instance = 0; instance < 400; ++instance) {
+    const int n = std::uniform_int_distribution<int>(10, 13)(rng);
+    const int m = 2;
+    const int d = std::uniform_int_distribution<int>(0, 5)(rng);
+    const oracle::Problem p = RandomProblem(rng, n, m);
+    const double mu = RandomMu(rng);
+    SCOPED_TRACE("instance " + std::to_string(instance) + ": " + Describe(p, mu, d));
+    double best = oracle::kInf;
+    for (int code = 0; code < (1 << n); ++code) {
+      std::vector<int> labels(n);
+      for (int t = 0; t < n; ++t) labels[t] = (code >> t) & 1;
+      if (oracle::Feasible(labels, d)) best = std::min(best, oracle::Evaluate(p, labels, mu).total);
+    }
+    LabellingOptions options;
+    options.mu = mu;
+    options.min_segment_length = d;
+    const LabellingResult r = SolveLabelling(ToProblem(p), options);
+    EXPECT_TRUE(r.feasible);
+    EXPECT_TRUE(oracle::Feasible(r.labels, d)) << LabelsString(r.labels);
+    EXPECT_TRUE(NearRel(r.total_cost, best)) << "optimum " << best << ", got " << r.total_cost;
+    EXPECT_TRUE(NearRel(oracle::Evaluate(p, r.labels, mu).total, r.total_cost));
+    if (HasFailure()) break;
+  }
+}
+
 TEST(LabellingBruteForce, SegmentsOfMatchesRunSplitting) {
   std::mt19937_64 rng(7);
   EXPECT_TRUE(SegmentsOf({}).empty());
