@@ -74,11 +74,15 @@ void ValidateAnnotation(const Annotation& annotation, const std::string& name) {
                   "one timestamp per value");
   }
   for (std::size_t i = 0; i < annotation.size(); ++i) {
-    const std::string where = name + ", frame " + std::to_string(i);
-    CheckValue(annotation.values[i], where);
+    // Built only on error: this loop runs over every frame.
+    auto where = [&] { return name + ", frame " + std::to_string(i); };
+    const double value = annotation.values[i];
+    if (!std::isfinite(value) || value < kMinAnnotation || value > kMaxAnnotation) {
+      CheckValue(value, where());
+    }
     if (!std::isfinite(annotation.timestamps[i]) ||
         (i > 0 && !(annotation.timestamps[i] > annotation.timestamps[i - 1]))) {
-      ThrowBadValue(where + ", timestamp", FormatNumber(annotation.timestamps[i]),
+      ThrowBadValue(where() + ", timestamp", FormatNumber(annotation.timestamps[i]),
                     "finite and greater than the previous timestamp");
     }
   }

@@ -25,21 +25,22 @@ void ValidateTrajectory(const Trajectory& trajectory, const std::string& name) {
                   "one timestamp per pose");
   }
   for (std::size_t i = 0; i < trajectory.size(); ++i) {
-    const std::string where = name + ", frame " + std::to_string(i);
+    // Built only on error: this loop runs over every frame of every take.
+    auto where = [&] { return name + ", frame " + std::to_string(i); };
     const Rigid3& pose = trajectory.poses[i];
     const double t = trajectory.timestamps[i];
-    if (!std::isfinite(t)) ThrowBadValue(where + ", timestamp", FormatNumber(t), "a finite number");
+    if (!std::isfinite(t)) ThrowBadValue(where() + ", timestamp", FormatNumber(t), "a finite number");
     if (i > 0 && !(t > trajectory.timestamps[i - 1])) {
-      ThrowBadValue(where + ", timestamp", FormatNumber(t),
+      ThrowBadValue(where() + ", timestamp", FormatNumber(t),
                     "greater than the previous timestamp " +
                         FormatNumber(trajectory.timestamps[i - 1]));
     }
     if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite()) {
-      ThrowBadValue(where, "a non-finite pose value", "finite translation and quaternion");
+      ThrowBadValue(where(), "a non-finite pose value", "finite translation and quaternion");
     }
     const double norm = pose.rotation.norm();
     if (std::abs(norm - 1.0) > 1e-6) {
-      ThrowBadValue(where + ", quaternion norm", FormatNumber(norm), "a unit quaternion");
+      ThrowBadValue(where() + ", quaternion norm", FormatNumber(norm), "a unit quaternion");
     }
   }
 }

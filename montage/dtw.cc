@@ -73,6 +73,31 @@ void CostRun(const PoseArrays& ref, int t, const PoseArrays& src, int first, int
   }
 }
 
+// True if no cell of the run can be a new strict prefix minimum: F(t, s) = C(t, s) + M(t-1, s)
+// >= `ceiling` for all of them. Uses C >= lambda |x_ref - x_src| and compares squares, so it needs
+// no square root. prev[i] = M(t-1, first + i).
+MMH_SIMD_CLONES
+bool NoNewMinimum(const PoseArrays& ref, int t, const PoseArrays& src, int first, int count,
+                  double lambda, double ceiling, const double* __restrict prev) {
+  const double atx = ref.tx[t], aty = ref.ty[t], atz = ref.tz[t];
+  const double lambda2 = lambda * lambda;
+  const double* __restrict btx = src.tx.data() + first;
+  const double* __restrict bty = src.ty.data() + first;
+  const double* __restrict btz = src.tz.data() + first;
+  // An integer OR reduction (a bool AND does not vectorise); full blocks get a constant trip count.
+  auto any_may_lower = [&](int n) {
+    long hits = 0;
+    for (int i = 0; i < n; ++i) {
+      const double ex = atx - btx[i], ey = aty - bty[i], ez = atz - btz[i];
+      const double slack = ceiling - prev[i];
+      hits |= static_cast<long>(slack > 0.0) &
+              static_cast<long>(lambda2 * (ex * ex + ey * ey + ez * ez) < slack * slack);
+    }
+    return hits != 0;
+  };
+  return count == kBlock ? !any_may_lower(kBlock) : !any_may_lower(count);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Lower bounds for pruning. Each block of kBlock source frames is enclosed in two balls: one in
 // R^4 around its quaternions (each taken with the sign closest to the block's first one) and one
@@ -126,27 +151,13 @@ BlockBalls MakeBlockBalls(const PoseArrays& src) {
   return b;
 }
 
-// Lower bound of C_match(reference frame t, any source frame of block j).
-inline double BlockLowerBound(const PoseArrays& ref, int t, const BlockBalls& b, int j,
-                              double lambda) {
-  const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
-  const double dx = ax - b.cx[j], dy = ay - b.cy[j], dz = az - b.cz[j], dw = aw - b.cw[j];
-  const double sx = ax + b.cx[j], sy = ay + b.cy[j], sz = az + b.cz[j], sw = aw + b.cw[j];
-  const double q = std::sqrt(
-      std::min(dx * dx + dy * dy + dz * dz + dw * dw, sx * sx + sy * sy + sz * sz + sw * sw));
-  const double ex = ref.tx[t] - b.mx[j], ey = ref.ty[t] - b.my[j], ez = ref.tz[t] - b.mz[j];
-  const double x = std::sqrt(ex * ex + ey * ey + ez * ez);
-  return (std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j])) * (1 - 1e-9);
-}
-
-// out[j] = BlockLowerBound(ref, t, b, j, lambda) for j in
+// out[j] = lower bound of C_match(reference frame t, any source frame of block j), j in
 // [first, last).
 MMH_SIMD_CLONES
 void LowerBoundRow(const PoseArrays& ref, int t, const BlockBalls& b, int first, int last,
                    double lambda, double* __restrict out) {
   const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
   const double atx = ref.tx[t], aty = ref.ty[t], atz = ref.tz[t];
-  // The same formula as BlockLowerBound, written out so that it vectorises.
   for (int j = first; j < last; ++j) {
     const double dx = ax - b.cx[j], dy = ay - b.cy[j], dz = az - b.cz[j], dw = aw - b.cw[j];
     const double sx = ax + b.cx[j], sy = ay + b.cy[j], sz = az + b.cz[j], sw = aw + b.cw[j];
@@ -177,13 +188,13 @@ class LiteralProgramme {
       : ref_(ref), src_(src), lambda_(lambda), n_(ref.size()), big_n_(src.size()),
         blocks_((big_n_ + kBlock - 1) / kBlock), words_((big_n_ + 63) / 64) {}
 
-  // `range(t)` gives the blocks [first, last] of row t worth visiting (blocks outside are +inf);
-  // `live(t, j, m)` says whether block j of row t may hold an optimal cell, given m = M(t-1, end of
-  // block j), the least prefix minimum of the previous row over the block. Returns the cost (inf
-  // if no warp runs through live cells only) and fills `warp`.
-  template <class Range, class Live>
-  double Run(const Range& range, const Live& live, std::vector<int>* warp,
-             std::int64_t* evaluated) {
+  // The pruning policy: `pruner.Range(t)` gives the blocks [first, last] of row t worth visiting
+  // (blocks outside are +inf); `pruner.BeginRow(t, first, last)` is called before a row's visit;
+  // `pruner.Live(t, j, m)` says whether block j of row t may hold an optimal cell, given
+  // m = M(t-1, end of block j), the least prefix minimum of the previous row over the block.
+  // Returns the cost (inf if no warp runs through live cells only) and fills `warp`.
+  template <class Pruner>
+  double Run(Pruner& pruner, std::vector<int>* warp, std::int64_t* evaluated) {
     bits_.assign(static_cast<std::size_t>(n_) * words_, 0);
     m_prev_.resize(big_n_);
     m_cur_.resize(big_n_);
@@ -191,7 +202,7 @@ class LiteralProgramme {
     end_cur_.assign(blocks_, kInf);
     live_prev_.assign(blocks_, 0);
     live_cur_.assign(blocks_, 0);
-    std::array<double, kBlock> cost{};
+    std::array<double, 2 * kBlock> cost{};
     double last_f = kInf;  // F(n-1, N-1)
 
     // Row 0: only w(0) = 0 is allowed; the prefix minimum is C(0, 0) along the whole row.
@@ -206,10 +217,12 @@ class LiteralProgramme {
     if (n_ == 1) last_f = big_n_ == 1 ? c0 : kInf;
 
     for (int t = 1; t < n_; ++t) {
-      auto [first_block, last_block] = range(t);
+      auto [first_block, last_block] = pruner.Range(t);
       // Below the previous row's first visited block every cell of row t-1 is +inf.
       first_block = std::max(first_block, prev_first);
+      pruner.BeginRow(t, first_block, last_block);
       double carry = kInf;  // prefix minimum of row t so far
+      int first_live = -1;  // first block of row t holding a finite value
       std::uint64_t* row_bits = bits_.data() + static_cast<std::size_t>(t) * words_;
       auto end_of_prev = [&](int j) {
         return j < prev_first ? kInf : (j > prev_last ? prev_tail : end_prev_[j]);
@@ -219,19 +232,31 @@ class LiteralProgramme {
         const int count = std::min(kBlock, big_n_ - first);
         const bool prev_live = j >= prev_first && j <= prev_last && live_prev_[j];
         const double before = j == 0 ? kInf : end_of_prev(j - 1);
-        if ((!prev_live && before == kInf) || !live(t, j, end_of_prev(j))) {
+        if ((!prev_live && before == kInf) || !pruner.Live(t, j, end_of_prev(j))) {
           live_cur_[j] = 0;
           end_cur_[j] = carry;
           continue;
         }
-        CostRun(ref_, t, src_, first, count, lambda_, cost.data());
-        *evaluated += count;
-        if (prev_live) {
-          const double* prev = m_prev_.data() + first;
-          for (int i = 0; i < count; ++i) cost[i] += prev[i];
-        } else {
-          for (int i = 0; i < count; ++i) cost[i] += before;
+        const double* prev = m_prev_.data() + first;
+        if (!prev_live) {
+          std::fill(cost.begin(), cost.begin() + count, before);
+          prev = cost.data();
         }
+        // A block that cannot lower the row's prefix minimum leaves it (and its bits) as they
+        // are. The margin of 1e-12 of the running cost dwarfs the rounding of F = C + M, so the
+        // result is bit-identical to evaluating every cell. The last cell's F is always needed.
+        if (carry < kInf && !(t == n_ - 1 && first + count == big_n_) &&
+            NoNewMinimum(ref_, t, src_, first, count, lambda_, carry * (1 + 1e-12), prev)) {
+          double* cur = m_cur_.data() + first;
+          for (int i = 0; i < count; ++i) cur[i] = carry;
+          live_cur_[j] = 1;
+          end_cur_[j] = carry;
+          if (first_live < 0) first_live = j;
+          continue;
+        }
+        CostRun(ref_, t, src_, first, count, lambda_, cost.data() + kBlock);
+        *evaluated += count;
+        for (int i = 0; i < count; ++i) cost[i] = cost[kBlock + i] + prev[i];
         std::uint64_t mask = 0;
         double* cur = m_cur_.data() + first;
         for (int i = 0; i < count; ++i) {
@@ -245,14 +270,16 @@ class LiteralProgramme {
         row_bits[j / kBlocksPerWord] |= mask << (kBlock * (j % kBlocksPerWord));
         live_cur_[j] = 1;
         end_cur_[j] = carry;
+        if (first_live < 0) first_live = j;
       }
       std::swap(m_prev_, m_cur_);
       std::swap(end_prev_, end_cur_);
       std::swap(live_prev_, live_cur_);
-      prev_first = first_block;
-      prev_last = std::max(last_block, first_block - 1);
+      if (first_live < 0) return kInf;  // nothing of row t is reachable
+      // Blocks of row t before its first live one are +inf: row t+1 starts there.
+      prev_first = first_live;
+      prev_last = last_block;
       prev_tail = carry;
-      if (carry == kInf) return kInf;  // nothing of row t is reachable
     }
     if (!(last_f < kInf)) return kInf;
     warp->assign(n_, 0);
@@ -287,12 +314,19 @@ class LiteralProgramme {
   std::vector<char> live_prev_, live_cur_;
 };
 
-struct AllLive {
-  bool operator()(int, int, double) const { return true; }
-};
-struct AllBlocks {
+// Pruning policies for LiteralProgramme::Run.
+struct NoPruning {
   int blocks;
-  std::pair<int, int> operator()(int) const { return {0, blocks - 1}; }
+  std::pair<int, int> Range(int) const { return {0, blocks - 1}; }
+  void BeginRow(int, int, int) {}
+  bool Live(int, int, double) const { return true; }
+};
+struct BandPruning {
+  const std::vector<int>& first;
+  const std::vector<int>& last;
+  std::pair<int, int> Range(int t) const { return {first[t], last[t]}; }
+  void BeginRow(int, int, int) {}
+  bool Live(int, int, double) const { return true; }
 };
 
 // The pruned literal DTW, exact. With lb(t, j) <= C(t, s) for s in block j (BlockBalls) and the
@@ -312,6 +346,7 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
   const int blocks = (big_n + kBlock - 1) / kBlock;
   const BlockBalls balls = MakeBlockBalls(src);
 
+  auto T0 = Clock::now();
   // 1. Upper bound U: a coarse warp on every kCoarse-th frame (both ends kept), then the exact
   // programme in a band of +-kRadius frames around it.
   constexpr int kCoarse = 8, kRadius = 24;
@@ -338,7 +373,8 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
   const PoseArrays coarse_ref = pick(ref, ref_index), coarse_src = pick(src, src_index);
   std::vector<int> coarse_warp;  // n >= 2 here, so both subsamples have >= 2 frames
   LiteralProgramme coarse(coarse_ref, coarse_src, lambda);
-  coarse.Run(AllBlocks{(coarse_src.size() + kBlock - 1) / kBlock}, AllLive{}, &coarse_warp, evaluated);
+  NoPruning all_coarse{(coarse_src.size() + kBlock - 1) / kBlock};
+  coarse.Run(all_coarse, &coarse_warp, evaluated);
   std::vector<int> band_first(n), band_last(n);
   for (int t = 0; t < n; ++t) {
     const int i =
@@ -354,12 +390,13 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
   band_last[n - 1] = blocks - 1;
   LiteralProgramme programme(ref, src, lambda);
   std::vector<int> band_warp;
-  const double upper = programme.Run(
-      [&](int t) { return std::make_pair(band_first[t], band_last[t]); }, AllLive{}, &band_warp,
-      evaluated);
+  auto T1 = Clock::now();
+  BandPruning band{band_first, band_last};
+  const double upper = programme.Run(band, &band_warp, evaluated);
   // Margin for the rounding of the bounds' sums.
   const double threshold = upper * (1 + 1e-9) + 1e-9;
 
+  auto T2 = Clock::now();
   // 2. Backward bounds BL(t, j), as floats rounded down (#n by #blocks). BL is non-decreasing in
   // j, so blocks past last_useful[t] (BL > U) are dead, and the terms they feed into row t-1 are
   // > U as well: each row only needs the blocks up to the next row's last useful one.
@@ -382,19 +419,33 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
     last_useful[t - 1] = last;
   }
 
+  auto T3 = Clock::now();
   // 3. The exact programme over the blocks that may hold an optimal cell.
-  const double cost = programme.Run(
-      [&](int t) { return std::make_pair(0, last_useful[t]); },
-      [&](int t, int j, double before_end) {
-        const double bound =
-            before_end + static_cast<double>(backward[static_cast<std::size_t>(t) * blocks + j]);
-        if (!(bound <= threshold)) return false;
-        return bound + BlockLowerBound(ref, t, balls, j, lambda) <= threshold;
-      },
-      warp, evaluated);
+  struct BoundPruning {
+    const PoseArrays& ref;
+    const BlockBalls& balls;
+    const std::vector<float>& backward;
+    const std::vector<int>& last_useful;
+    std::vector<double>& lb_row;
+    int blocks;
+    double lambda, threshold;
+    std::pair<int, int> Range(int t) const { return {0, last_useful[t]}; }
+    void BeginRow(int t, int first, int last) {
+      if (last >= first) LowerBoundRow(ref, t, balls, first, last + 1, lambda, lb_row.data());
+    }
+    bool Live(int t, int j, double before_end) const {
+      return before_end + static_cast<double>(backward[static_cast<std::size_t>(t) * blocks + j]) +
+                 lb_row[j] <=
+             threshold;
+    }
+  } bound{ref, balls, backward, last_useful, lb_row, blocks, lambda, threshold};
+  const double cost = programme.Run(bound, warp, evaluated);
+  auto T4 = Clock::now();
+  if (std::getenv("MMH_DTW_DEBUG")) std::fprintf(stderr, "coarse %.2f band %.2f backward %.2f exact %.2f ms\n", 1e3*std::chrono::duration<double>(T1-T0).count(), 1e3*std::chrono::duration<double>(T2-T1).count(), 1e3*std::chrono::duration<double>(T3-T2).count(), 1e3*std::chrono::duration<double>(T4-T3).count());
   if (cost < kInf) return cost;
   // Unreachable by the argument above; kept so that a bound bug can never lose the warp.
-  return programme.Run(AllBlocks{blocks}, AllLive{}, warp, evaluated);
+  NoPruning all{blocks};
+  return programme.Run(all, warp, evaluated);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -518,7 +569,8 @@ DtwResult ComputeDtw(const Trajectory& reference, const Trajectory& source,
         cost = PrunedLiteral(ref, src, options.lambda, &result.warp, &evaluated);
       } else {
         LiteralProgramme programme(ref, src, options.lambda);
-        cost = programme.Run(AllBlocks{(src.size() + kBlock - 1) / kBlock}, AllLive{}, &result.warp, &evaluated);
+        NoPruning all{(src.size() + kBlock - 1) / kBlock};
+        cost = programme.Run(all, &result.warp, &evaluated);
       }
       break;
     }

@@ -37,9 +37,9 @@ struct Columns {
   }
 };
 
-// out[i] = C_match(l[a + i], k[b + i]) for i < count: one diagonal of eq. 9's window.
-MMH_SIMD_CLONES
-void DiagonalCosts(const Columns& l, int a, const Columns& k, int b, int count, double lambda,
+// out[i] = C_match(l[a + i], k[b + i]) for i < count: one diagonal of eq. 9's window. Inlined into
+// each SIMD clone of its caller (one dispatch per take pair, not per window).
+[[gnu::always_inline]] inline void DiagonalCosts(const Columns& l, int a, const Columns& k, int b, int count, double lambda,
                    double* __restrict out) {
   const double* __restrict ax = l.v[0].data() + a;
   const double* __restrict ay = l.v[1].data() + a;
@@ -63,6 +63,7 @@ void DiagonalCosts(const Columns& l, int a, const Columns& k, int b, int count, 
 
 // Eq. 9 around centres cl (take l) and ck (take k, already w_k(t+1) - 1), over the valid part of
 // the window, summed in h order.
+MMH_SIMD_CLONES
 double WindowCost(const Columns& l, int cl, const Columns& k, int ck,
                   const SmoothnessOptions& options, double* scratch) {
   const int h = options.half_window;
@@ -93,6 +94,58 @@ void SmoothnessOptions::Validate(const std::string& prefix) const {
   }
 }
 
+namespace {
+
+// All entries C_s(., l, k) of one ordered pair of takes. Eq. 9 sums C_match along a diagonal of the
+// (source l, source k) plane around the centre (w_l(t), w_k(t+1) - 1). Consecutive frames whose
+// centres lie on the same diagonal share most of their window, so each C_match of such a run is
+// computed once, and every window is then summed from those values in h order, exactly as
+// WindowCost sums it: the table equals the direct evaluation to the last bit.
+MMH_SIMD_CLONES
+void FillPair(const Columns& take_l, const std::vector<int>& warp_l, const Columns& take_k,
+              const std::vector<int>& warp_k, int l, int k, const SmoothnessOptions& options,
+              TransitionCosts* table, std::vector<double>* scratch) {
+  const int n = static_cast<int>(warp_l.size());
+  const int h = options.half_window;
+  const int m = table->takes;
+  int t = 0;
+  while (t < n - 1) {
+    // The run [t, end) of frames on one diagonal a - b = offset, centres not going back and not
+    // jumping past a window.
+    const int offset = warp_l[t] - (warp_k[t + 1] - 1);
+    int end = t + 1;
+    while (end < n - 1 && warp_l[end] - (warp_k[end + 1] - 1) == offset &&
+           warp_l[end] >= warp_l[end - 1] && warp_l[end] - warp_l[end - 1] <= 2 * h + 1) {
+      ++end;
+    }
+    // Source frames a of take l (b = a - offset of take k) that any window of the run uses.
+    const int lo = std::max({warp_l[t] - h, 0, offset});
+    const int hi = std::min({warp_l[end - 1] + h, take_l.size - 1, take_k.size - 1 + offset});
+    if (hi >= lo) {
+      scratch->resize(hi - lo + 1);
+      DiagonalCosts(take_l, lo, take_k, lo - offset, hi - lo + 1, options.lambda,
+                    scratch->data());
+    }
+    for (int u = t; u < end; ++u) {
+      const int c = warp_l[u];
+      const int first = std::max({c - h, 0, offset});
+      const int last = std::min({c + h, take_l.size - 1, take_k.size - 1 + offset});
+      const int valid = last - first + 1;
+      double sum = 0.0;
+      if (valid > 0) {
+        for (int a = first; a <= last; ++a) sum += (*scratch)[a - lo];
+        if (options.window_edge == WindowEdge::kScaledMean && valid < 2 * h + 1) {
+          sum = sum / valid * (2 * h + 1);
+        }
+      }
+      table->values[(static_cast<std::size_t>(u) * m + l) * m + k] = sum;
+    }
+    t = end;
+  }
+}
+
+}  // namespace
+
 TransitionCosts ComputeSmoothnessCosts(const std::vector<Trajectory>& takes,
                                        const std::vector<std::vector<int>>& warps,
                                        const SmoothnessOptions& options) {
@@ -105,22 +158,14 @@ TransitionCosts ComputeSmoothnessCosts(const std::vector<Trajectory>& takes,
   std::vector<Columns> columns;
   columns.reserve(m);
   for (const auto& take : takes) columns.emplace_back(take);
-  // Rows are independent: the table is the same for any thread count.
-  tbb::parallel_for(tbb::blocked_range<int>(0, std::max(0, n - 1), 64),
-                    [&](const tbb::blocked_range<int>& range) {
-                      std::vector<double> scratch(2 * options.half_window + 1);
-                      for (int t = range.begin(); t < range.end(); ++t) {
-                        double* row = table.values.data() + static_cast<std::size_t>(t) * m * m;
-                        for (int l = 0; l < m; ++l) {
-                          for (int k = 0; k < m; ++k) {
-                            if (k == l) continue;
-                            row[l * m + k] = WindowCost(columns[l], warps[l][t], columns[k],
-                                                        warps[k][t + 1] - 1, options,
-                                                        scratch.data());
-                          }
-                        }
-                      }
-                    });
+  // One task per ordered pair; each writes only its own entries, so the table is the same for any
+  // thread count.
+  tbb::parallel_for(0, m * m, [&](int pair) {
+    const int l = pair / m, k = pair % m;
+    if (l == k) return;
+    std::vector<double> scratch;
+    FillPair(columns[l], warps[l], columns[k], warps[k], l, k, options, &table, &scratch);
+  });
   return table;
 }
 
