@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "montage/compose.h"
+#include "tests/montage/oracles.h"
 #include "tools/synthetic_takes.h"
 
 namespace {
@@ -96,6 +97,29 @@ void BM_Labelling(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(mmh::montage::SolveLabelling(problem, labelling));
 }
 BENCHMARK(BM_Labelling)->ArgName("d")->Arg(60)->Arg(0)->Unit(benchmark::kMillisecond);
+
+// For comparison: the textbook O(n^2 m^2) semi-Markov programme (the tests' second oracle) on the
+// same costs, d = 60.
+void BM_TextbookSemiMarkov(benchmark::State& state) {
+  const auto& set = Takes(10, 3000);
+  ComposeOptions options;
+  const auto montage = mmh::montage::Compose(set.takes, set.annotations, options);
+  mmh::montage::oracle::Problem problem;
+  problem.n = montage.summary.reference_frames;
+  problem.m = 10;
+  problem.data.resize(static_cast<std::size_t>(problem.n) * problem.m);
+  for (int t = 0; t < problem.n; ++t) {
+    for (int l = 0; l < problem.m; ++l) {
+      problem.data[t * problem.m + l] = -montage.warped_annotations[l][t];
+    }
+  }
+  problem.trans =
+      mmh::montage::ComputeSmoothnessCosts(set.takes, montage.warps, options.smoothness).values;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(mmh::montage::oracle::SemiMarkovOptimum(problem, 100.0, 60));
+  }
+}
+BENCHMARK(BM_TextbookSemiMarkov)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 

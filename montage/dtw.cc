@@ -6,8 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 #include "core/error.h"
 #include "montage/match_cost.h"
@@ -346,7 +344,6 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
   const int blocks = (big_n + kBlock - 1) / kBlock;
   const BlockBalls balls = MakeBlockBalls(src);
 
-  auto T0 = Clock::now();
   // 1. Upper bound U: a coarse warp on every kCoarse-th frame (both ends kept), then the exact
   // programme in a band of +-kRadius frames around it.
   constexpr int kCoarse = 8, kRadius = 24;
@@ -390,13 +387,11 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
   band_last[n - 1] = blocks - 1;
   LiteralProgramme programme(ref, src, lambda);
   std::vector<int> band_warp;
-  auto T1 = Clock::now();
   BandPruning band{band_first, band_last};
   const double upper = programme.Run(band, &band_warp, evaluated);
   // Margin for the rounding of the bounds' sums.
   const double threshold = upper * (1 + 1e-9) + 1e-9;
 
-  auto T2 = Clock::now();
   // 2. Backward bounds BL(t, j), as floats rounded down (#n by #blocks). BL is non-decreasing in
   // j, so blocks past last_useful[t] (BL > U) are dead, and the terms they feed into row t-1 are
   // > U as well: each row only needs the blocks up to the next row's last useful one.
@@ -419,7 +414,6 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
     last_useful[t - 1] = last;
   }
 
-  auto T3 = Clock::now();
   // 3. The exact programme over the blocks that may hold an optimal cell.
   struct BoundPruning {
     const PoseArrays& ref;
@@ -440,8 +434,6 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
     }
   } bound{ref, balls, backward, last_useful, lb_row, blocks, lambda, threshold};
   const double cost = programme.Run(bound, warp, evaluated);
-  auto T4 = Clock::now();
-  if (std::getenv("MMH_DTW_DEBUG")) std::fprintf(stderr, "coarse %.2f band %.2f backward %.2f exact %.2f ms\n", 1e3*std::chrono::duration<double>(T1-T0).count(), 1e3*std::chrono::duration<double>(T2-T1).count(), 1e3*std::chrono::duration<double>(T3-T2).count(), 1e3*std::chrono::duration<double>(T4-T3).count());
   if (cost < kInf) return cost;
   // Unreachable by the argument above; kept so that a bound bug can never lose the warp.
   NoPruning all{blocks};
