@@ -76,8 +76,8 @@ void BM_Dtw(benchmark::State& state) {
 }
 BENCHMARK(BM_Dtw)->ArgName("prune")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
-// The labelling alone (constrained, d = 60) on the standard instance's costs.
-void BM_Labelling(benchmark::State& state) {
+// The labelling problem (eqs. 8, 9) of the standard instance, as Compose builds it.
+mmh::montage::LabellingProblem StandardProblem() {
   const auto& set = Takes(10, 3000);
   ComposeOptions options;
   const auto montage = mmh::montage::Compose(set.takes, set.annotations, options);
@@ -92,6 +92,12 @@ void BM_Labelling(benchmark::State& state) {
   }
   problem.transitions = mmh::montage::ComputeSmoothnessCosts(set.takes, montage.warps,
                                                              options.smoothness);
+  return problem;
+}
+
+// The labelling alone (constrained, d = 60) on the standard instance's costs.
+void BM_Labelling(benchmark::State& state) {
+  const auto problem = StandardProblem();
   mmh::montage::LabellingOptions labelling;
   labelling.min_segment_length = static_cast<int>(state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(mmh::montage::SolveLabelling(problem, labelling));
@@ -101,20 +107,12 @@ BENCHMARK(BM_Labelling)->ArgName("d")->Arg(60)->Arg(0)->Unit(benchmark::kMillise
 // For comparison: the textbook O(n^2 m^2) semi-Markov programme (the tests' second oracle) on the
 // same costs, d = 60.
 void BM_TextbookSemiMarkov(benchmark::State& state) {
-  const auto& set = Takes(10, 3000);
-  ComposeOptions options;
-  const auto montage = mmh::montage::Compose(set.takes, set.annotations, options);
+  const auto standard = StandardProblem();
   mmh::montage::oracle::Problem problem;
-  problem.n = montage.summary.reference_frames;
-  problem.m = 10;
-  problem.data.resize(static_cast<std::size_t>(problem.n) * problem.m);
-  for (int t = 0; t < problem.n; ++t) {
-    for (int l = 0; l < problem.m; ++l) {
-      problem.data[t * problem.m + l] = -montage.warped_annotations[l][t];
-    }
-  }
-  problem.trans =
-      mmh::montage::ComputeSmoothnessCosts(set.takes, montage.warps, options.smoothness).values;
+  problem.n = standard.frames;
+  problem.m = standard.takes;
+  problem.data = standard.data;
+  problem.trans = standard.transitions.values;
   for (auto _ : state) {
     benchmark::DoNotOptimize(mmh::montage::oracle::SemiMarkovOptimum(problem, 100.0, 60));
   }

@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/tum_io.h"
 #include "montage/compose.h"
+#include "montage/layered.h"
 
 namespace mmh::cli {
 namespace {
@@ -23,6 +24,7 @@ struct ComposeArgs {
   CommonFlags common;
   std::vector<std::string> takes;
   std::vector<std::string> annotations;
+  std::vector<int> markers;
 };
 
 std::string TimelineCsv(const montage::Montage& montage) {
@@ -73,6 +75,19 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
   }
   const montage::Montage montage = montage::Compose(takes, annotations, options, names);
 
+  // Spatial markers on the montage's timeline (at least 60 frames apart, paper).
+  Trajectory marker_poses;
+  if (!args.markers.empty()) {
+    montage::SpatialMarkers markers;
+    for (int frame : args.markers) markers.Add("montage", frame);
+    const auto poses = markers.Poses({{"montage", montage.trajectory}});
+    const auto all = markers.All();
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      marker_poses.timestamps.push_back(montage.trajectory.timestamps[all[i].frame]);
+      marker_poses.poses.push_back(poses[i]);
+    }
+  }
+
   nlohmann::json resolved;
   resolved["montage"] = ToJson(options);
   nlohmann::json summary = montage::SummaryToJson(montage.summary, montage.segments);
@@ -85,6 +100,9 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
            "MotionMontage montage of " + std::to_string(takes.size()) + " takes (mmh compose)\n" +
                "timestamp tx ty tz qx qy qz qw");
   WriteFileAtomically(out / "segments.csv", montage::SegmentsToCsv(montage.segments));
+  if (!marker_poses.empty()) {
+    WriteTum(out / "markers.tum", marker_poses, "spatial markers: montage poses at the marked frames");
+  }
   WriteFileAtomically(out / "timeline.csv", TimelineCsv(montage));
   WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
@@ -124,6 +142,9 @@ void AddComposeCommand(CLI::App& app, const std::vector<std::string>& argv) {
       ->required()
       ->expected(1, -1);
   cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
+  cmd->add_option("--markers", args->markers,
+                  "Spatial markers: montage frames (at least 60 apart); writes markers.tum")
+      ->expected(1, -1);
   cmd->add_option("--config", args->common.config_file, "JSON config with a 'montage' section");
   cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
       ->take_all();

@@ -110,6 +110,23 @@ TEST_F(ComposeCliTest, SetOverridesReachTheResolvedConfig) {
   EXPECT_NE(resolved.find("\"weight\": \"smoothstep\""), std::string::npos);
 }
 
+TEST_F(ComposeCliTest, MarkersWriteTheMontagePosesAndKeepTheirSpacing) {
+  const fs::path out = dir_ / "out";
+  const auto r = RunMmh("compose " + Inputs() + " --out " + out.string() + " --quiet --markers 10 70");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Trajectory markers = ReadTum(out / "markers.tum");
+  const Trajectory montage = ReadTum(out / "montage.tum");
+  ASSERT_EQ(markers.size(), 2u);
+  EXPECT_EQ(markers.timestamps[1], montage.timestamps[70]);
+  EXPECT_EQ(markers.poses[1].translation, montage.poses[70].translation);
+  const fs::path out2 = dir_ / "out2";
+  const auto bad = RunMmh("compose " + Inputs() + " --out " + out2.string() + " --markers 10 69");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("frame 69"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("at least 60 frames"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(out2 / "montage.tum"));
+}
+
 struct BadCase {
   std::string name;
   std::string extra;                // appended arguments
