@@ -103,6 +103,10 @@ bool NoNewMinimum(const PoseArrays& ref, int t, const PoseArrays& src, int first
 //   C_match(A, T_src(s)) >= max(0, min(|q - c_j|, |q + c_j|) - r_j) + lambda max(0, |x - m_j| - R_j).
 struct BlockBalls {
   std::vector<double> cx, cy, cz, cw, rq, mx, my, mz, rt;
+  // The same in single precision (radii rounded up) for the fast bound rows, and the bound on
+  // their rounding error (see LowerBoundRowFloat).
+  std::vector<float> fcx, fcy, fcz, fcw, frq, fmx, fmy, fmz, frt;
+  double float_margin = 0.0;
 };
 
 BlockBalls MakeBlockBalls(const PoseArrays& src) {
@@ -146,7 +150,29 @@ BlockBalls MakeBlockBalls(const PoseArrays& src) {
     b.rq[j] = rq * (1 + 1e-9) + 1e-12;
     b.rt[j] = rt * (1 + 1e-9) + 1e-12;
   }
+  auto to_float = [](const std::vector<double>& v, double scale) {
+    std::vector<float> f(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) f[i] = static_cast<float>(v[i] * scale);
+    return f;
+  };
+  // Radii scaled up by 2^-20 so that the conversion (relative error <= 2^-24) never shrinks them.
+  b.fcx = to_float(b.cx, 1), b.fcy = to_float(b.cy, 1), b.fcz = to_float(b.cz, 1);
+  b.fcw = to_float(b.cw, 1), b.fmx = to_float(b.mx, 1), b.fmy = to_float(b.my, 1);
+  b.fmz = to_float(b.mz, 1), b.frq = to_float(b.rq, 1 + 0x1p-20), b.frt = to_float(b.rt, 1 + 0x1p-20);
   return b;
+}
+
+// Sets the margin of the single-precision bounds for a reference take: with u = 2^-24 and X the
+// largest translation coordinate of the reference and the block centres, the float rotation term
+// is within 30u of its exact value and the translation term within 40uX + 8u, so subtracting
+// 64u (1 + lambda (1 + 2X)) keeps every float bound below the double one.
+void SetFloatMargin(const PoseArrays& ref, double lambda, BlockBalls* b) {
+  double x = 0.0;
+  const BlockBalls& c = *b;
+  for (const std::vector<double>* v : {&ref.tx, &ref.ty, &ref.tz, &c.mx, &c.my, &c.mz}) {
+    for (double c : *v) x = std::max(x, std::abs(c));
+  }
+  b->float_margin = 64 * 0x1p-24 * (1 + lambda * (1 + 2 * x));
 }
 
 // out[j] = lower bound of C_match(reference frame t, any source frame of block j), j in
@@ -164,6 +190,39 @@ void LowerBoundRow(const PoseArrays& ref, int t, const BlockBalls& b, int first,
     const double ex = atx - b.mx[j], ey = aty - b.my[j], ez = atz - b.mz[j];
     const double x = std::sqrt(ex * ex + ey * ey + ez * ez);
     out[j] = (std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j])) * (1 - 1e-9);
+  }
+}
+
+// out[j] = a lower bound of C_match(reference frame t, any source frame of block j), j in
+// [first, last), computed in single precision (twice the lanes, cheaper square roots) and
+// lowered by the rounding margin of SetFloatMargin.
+MMH_SIMD_CLONES
+void LowerBoundRowFloat(const PoseArrays& ref, int t, const BlockBalls& b, int first, int last,
+                        double lambda, double* __restrict out) {
+  const float ax = static_cast<float>(ref.qx[t]), ay = static_cast<float>(ref.qy[t]);
+  const float az = static_cast<float>(ref.qz[t]), aw = static_cast<float>(ref.qw[t]);
+  const float atx = static_cast<float>(ref.tx[t]), aty = static_cast<float>(ref.ty[t]);
+  const float atz = static_cast<float>(ref.tz[t]);
+  const float flambda = static_cast<float>(lambda);
+  const double margin = b.float_margin;
+  const float* __restrict cx = b.fcx.data();
+  const float* __restrict cy = b.fcy.data();
+  const float* __restrict cz = b.fcz.data();
+  const float* __restrict cw = b.fcw.data();
+  const float* __restrict mx = b.fmx.data();
+  const float* __restrict my = b.fmy.data();
+  const float* __restrict mz = b.fmz.data();
+  const float* __restrict rq = b.frq.data();
+  const float* __restrict rt = b.frt.data();
+  for (int j = first; j < last; ++j) {
+    const float dx = ax - cx[j], dy = ay - cy[j], dz = az - cz[j], dw = aw - cw[j];
+    const float sx = ax + cx[j], sy = ay + cy[j], sz = az + cz[j], sw = aw + cw[j];
+    const float q = std::sqrt(std::min(dx * dx + dy * dy + dz * dz + dw * dw,
+                                       sx * sx + sy * sy + sz * sz + sw * sw));
+    const float ex = atx - mx[j], ey = aty - my[j], ez = atz - mz[j];
+    const float x = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const float lb = std::max(0.0f, q - rq[j]) + flambda * std::max(0.0f, x - rt[j]);
+    out[j] = std::max(0.0, static_cast<double>(lb) - margin);
   }
 }
 
@@ -342,7 +401,8 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
                      std::vector<int>* warp, std::int64_t* evaluated) {
   const int n = ref.size(), big_n = src.size();
   const int blocks = (big_n + kBlock - 1) / kBlock;
-  const BlockBalls balls = MakeBlockBalls(src);
+  BlockBalls balls = MakeBlockBalls(src);
+  SetFloatMargin(ref, lambda, &balls);
 
   // 1. Upper bound U: a coarse warp on every kCoarse-th frame (both ends kept), then the exact
   // programme in a band of +-kRadius frames around it.
@@ -403,7 +463,7 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
     const int limit = last_useful[t];
     StoreBelow(acc.data(), limit + 1, backward.data() + static_cast<std::size_t>(t) * blocks);
     if (t == 0) break;
-    LowerBoundRow(ref, t, balls, 0, limit + 1, lambda, lb_row.data());
+    LowerBoundRowFloat(ref, t, balls, 0, limit + 1, lambda, lb_row.data());
     double suffix = kInf;
     for (int j = limit; j >= 0; --j) {
       suffix = std::min(suffix, lb_row[j] + acc[j]);
@@ -425,7 +485,9 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
     double lambda, threshold;
     std::pair<int, int> Range(int t) const { return {0, last_useful[t]}; }
     void BeginRow(int t, int first, int last) {
-      if (last >= first) LowerBoundRow(ref, t, balls, first, last + 1, lambda, lb_row.data());
+      if (last >= first) {
+        LowerBoundRowFloat(ref, t, balls, first, last + 1, lambda, lb_row.data());
+      }
     }
     bool Live(int t, int j, double before_end) const {
       return before_end + static_cast<double>(backward[static_cast<std::size_t>(t) * blocks + j]) +
