@@ -175,24 +175,6 @@ void SetFloatMargin(const PoseArrays& ref, double lambda, BlockBalls* b) {
   b->float_margin = 64 * 0x1p-24 * (1 + lambda * (1 + 2 * x));
 }
 
-// out[j] = lower bound of C_match(reference frame t, any source frame of block j), j in
-// [first, last).
-MMH_SIMD_CLONES
-void LowerBoundRow(const PoseArrays& ref, int t, const BlockBalls& b, int first, int last,
-                   double lambda, double* __restrict out) {
-  const double ax = ref.qx[t], ay = ref.qy[t], az = ref.qz[t], aw = ref.qw[t];
-  const double atx = ref.tx[t], aty = ref.ty[t], atz = ref.tz[t];
-  for (int j = first; j < last; ++j) {
-    const double dx = ax - b.cx[j], dy = ay - b.cy[j], dz = az - b.cz[j], dw = aw - b.cw[j];
-    const double sx = ax + b.cx[j], sy = ay + b.cy[j], sz = az + b.cz[j], sw = aw + b.cw[j];
-    const double q = std::sqrt(std::min(dx * dx + dy * dy + dz * dz + dw * dw,
-                                        sx * sx + sy * sy + sz * sz + sw * sw));
-    const double ex = atx - b.mx[j], ey = aty - b.my[j], ez = atz - b.mz[j];
-    const double x = std::sqrt(ex * ex + ey * ey + ez * ez);
-    out[j] = (std::max(0.0, q - b.rq[j]) + lambda * std::max(0.0, x - b.rt[j])) * (1 - 1e-9);
-  }
-}
-
 // out[j] = a lower bound of C_match(reference frame t, any source frame of block j), j in
 // [first, last), computed in single precision (twice the lanes, cheaper square roots) and
 // lowered by the rounding margin of SetFloatMargin.
