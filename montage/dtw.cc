@@ -22,7 +22,9 @@ namespace mmh::montage {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Pruning granularity: blocks of kBlock source frames (64 / kBlock per backtracking word).
+// Pruning granularity: blocks of kBlock source frames (64 / kBlock per backtracking word). A
+// compile-time knob (-DMMH_DTW_BLOCK=8|16|32); 16 measured fastest on the standard instance
+// (8: 10.9 ms, 16: 7.2 ms, 32: 7.2 ms per DTW at the time of the comparison).
 #ifndef MMH_DTW_BLOCK
 #define MMH_DTW_BLOCK 16
 #endif
@@ -251,13 +253,13 @@ class LiteralProgramme {
     end_prev_[0] = c0;
     live_prev_[0] = 1;
     bits_[0] = 1;
-    int prev_first = 0, prev_last = 0;  // visited blocks of the previous row
+    int prev_first = 0, prev_last = 0;  // previous row: first live block, last visited block
     double prev_tail = c0;               // its prefix minimum after prev_last
     if (n_ == 1) last_f = big_n_ == 1 ? c0 : kInf;
 
     for (int t = 1; t < n_; ++t) {
       auto [first_block, last_block] = pruner.Range(t);
-      // Below the previous row's first visited block every cell of row t-1 is +inf.
+      // Before the previous row's first live block every cell of row t-1 is +inf.
       first_block = std::max(first_block, prev_first);
       pruner.BeginRow(t, first_block, last_block);
       double carry = kInf;  // prefix minimum of row t so far
