@@ -12,14 +12,19 @@
 namespace mmh::montage {
 namespace {
 
-TEST(DtwPruning, ExactFarFromTheOrigin) {
+// Similar takes of a story: the reference has `frames`, the others +-10 %.
+synthetic::TakeSet Story(int takes, int frames, std::uint64_t seed) {
   synthetic::TakeSetOptions options;
-  options.takes = 3;
-  options.reference_frames = 600;
-  options.min_frames = 540;
-  options.max_frames = 660;
-  options.seed = 3;
-  const auto set = synthetic::MakeTakeSet(options);
+  options.takes = takes;
+  options.reference_frames = frames;
+  options.min_frames = frames * 9 / 10;
+  options.max_frames = frames * 11 / 10;
+  options.seed = seed;
+  return synthetic::MakeTakeSet(options);
+}
+
+TEST(DtwPruning, ExactFarFromTheOrigin) {
+  const auto set = Story(3, 600, 3);
   for (double offset : {0.0, 1e3, 1e5}) {
     SCOPED_TRACE("offset " + std::to_string(offset));
     std::vector<Trajectory> takes = set.takes;
@@ -39,13 +44,7 @@ TEST(DtwPruning, ExactFarFromTheOrigin) {
 }
 
 TEST(DtwPruning, PrunesOnSimilarTakes) {
-  synthetic::TakeSetOptions options;
-  options.takes = 2;
-  options.reference_frames = 1500;
-  options.min_frames = 1350;
-  options.max_frames = 1650;
-  options.seed = 11;
-  const auto set = synthetic::MakeTakeSet(options);
+  const auto set = Story(2, 1500, 11);
   const DtwResult a = ComputeDtw(set.takes[0], set.takes[1], DtwOptions{});
   // All passes together evaluate well under a third of the cells on similar takes.
   EXPECT_LT(a.summary.cells_evaluated, a.summary.cells_total / 3) << a.summary.cells_evaluated;
