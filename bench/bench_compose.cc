@@ -71,8 +71,7 @@ void BM_Dtw(benchmark::State& state) {
   options.prune = state.range(0) != 0;
   mmh::montage::DtwResult result;
   for (auto _ : state) result = mmh::montage::ComputeDtw(set.takes[0], set.takes[1], options);
-  state.counters["cells_%"] =
-      100.0 * result.summary.cells_evaluated / result.summary.cells_total;
+  state.counters["cells_%"] = 100.0 * result.summary.cells_evaluated / result.summary.cells_total;
 }
 BENCHMARK(BM_Dtw)->ArgName("prune")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
@@ -90,8 +89,8 @@ mmh::montage::LabellingProblem StandardProblem() {
       problem.data[t * problem.takes + l] = -montage.warped_annotations[l][t];
     }
   }
-  problem.transitions = mmh::montage::ComputeSmoothnessCosts(set.takes, montage.warps,
-                                                             options.smoothness);
+  problem.transitions =
+      mmh::montage::ComputeSmoothnessCosts(set.takes, montage.warps, options.smoothness);
   return problem;
 }
 

@@ -1,12 +1,12 @@
 #include "cli/compose_command.h"
 
+#include <tbb/global_control.h>
+
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
-
-#include <tbb/global_control.h>
 
 #include "cli/provenance.h"
 #include "core/annotation.h"
@@ -37,7 +37,8 @@ std::string TimelineCsv(const montage::Montage& montage) {
   for (std::size_t t = 0; t < montage.labels.size(); ++t) {
     out << t << ',' << montage.labels[t];
     for (std::size_t l = 0; l < m; ++l) out << ',' << montage.warps[l][t];
-    for (std::size_t l = 0; l < m; ++l) out << ',' << FormatNumber(montage.warped_annotations[l][t]);
+    for (std::size_t l = 0; l < m; ++l)
+      out << ',' << FormatNumber(montage.warped_annotations[l][t]);
     out << '\n';
   }
   return out.str();
@@ -51,14 +52,15 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
   const auto options = config.Get<montage::ComposeOptions>("montage");
 
   if (args.takes.size() != args.annotations.size()) {
-    ThrowBadValue("--annotations", std::to_string(args.annotations.size()) + " files for " +
-                                       std::to_string(args.takes.size()) + " takes",
+    ThrowBadValue("--annotations",
+                  std::to_string(args.annotations.size()) + " files for " +
+                      std::to_string(args.takes.size()) + " takes",
                   "one annotation file per take, in the same order");
   }
   std::unique_ptr<tbb::global_control> threads;
   if (args.common.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(
-        tbb::global_control::max_allowed_parallelism, args.common.threads);
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    args.common.threads);
   }
 
   // Everything is read and computed before anything is written: bad input leaves no output.
@@ -101,14 +103,15 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
                "timestamp tx ty tz qx qy qz qw");
   WriteFileAtomically(out / "segments.csv", montage::SegmentsToCsv(montage.segments));
   if (!marker_poses.empty()) {
-    WriteTum(out / "markers.tum", marker_poses, "spatial markers: montage poses at the marked frames");
+    WriteTum(out / "markers.tum", marker_poses,
+             "spatial markers: montage poses at the marked frames");
   }
   WriteFileAtomically(out / "timeline.csv", TimelineCsv(montage));
   WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
-  WriteFileAtomically(out / "run.json",
-                      Provenance(argv, resolved, args.common.threads, summary["seconds"]).dump(2) +
-                          "\n");
+  WriteFileAtomically(
+      out / "run.json",
+      Provenance(argv, resolved, args.common.threads, summary["seconds"]).dump(2) + "\n");
 
   if (!args.common.quiet) {
     const auto& s = montage.summary;
@@ -117,8 +120,8 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
               << " reference frames)\n"
               << "cost: total " << s.total_cost << " = data " << s.data_cost << " + smoothness "
               << s.smoothness_cost << "; without the segment constraint " << s.unconstrained_cost
-              << " (+" << s.constraint_increase_percent << " %, "
-              << s.unconstrained_short_segments << " short segments avoided)\n"
+              << " (+" << s.constraint_increase_percent << " %, " << s.unconstrained_short_segments
+              << " short segments avoided)\n"
               << "time: " << s.seconds.total * 1e3 << " ms (dtw " << s.seconds.dtw * 1e3
               << ", smoothness " << s.seconds.smoothness * 1e3 << ", labelling "
               << s.seconds.labelling * 1e3 << ")\n";

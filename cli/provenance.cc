@@ -1,16 +1,15 @@
 #include "cli/provenance.h"
 
+#include <tbb/version.h>
 #include <unistd.h>
 
+#include <Eigen/Core>
 #include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <memory>
-
-#include <Eigen/Core>
-#include <tbb/version.h>
 
 #ifndef MMH_SOURCE_DIR
 #define MMH_SOURCE_DIR "."
@@ -35,7 +34,8 @@ std::string GitCommit() {
   const std::string dir = MMH_SOURCE_DIR;
   const std::string commit = Run("git -C '" + dir + "' rev-parse HEAD 2>/dev/null");
   if (commit.empty()) return "unknown";
-  const std::string dirty = Run("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null");
+  const std::string dirty =
+      Run("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null");
   return dirty.empty() ? commit : commit + "-dirty";
 }
 
@@ -50,8 +50,9 @@ std::string ConfigHash(const nlohmann::json& resolved_config) {
   return text;
 }
 
-nlohmann::json Provenance(const std::vector<std::string>& argv, const nlohmann::json& resolved_config,
-                          int threads, const nlohmann::json& timings) {
+nlohmann::json Provenance(const std::vector<std::string>& argv,
+                          const nlohmann::json& resolved_config, int threads,
+                          const nlohmann::json& timings) {
   nlohmann::json run;
   run["command"] = argv;
   run["mmh_version"] = MMH_VERSION;

@@ -1,10 +1,9 @@
 // Provenance of a run (run.json): what produced the results beside it.
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace mmh::cli {
 
@@ -15,7 +14,8 @@ std::string GitCommit();
 std::string ConfigHash(const nlohmann::json& resolved_config);
 
 // run.json: command line, commit, config hash, library versions, host, threads, timings.
-nlohmann::json Provenance(const std::vector<std::string>& argv, const nlohmann::json& resolved_config,
-                          int threads, const nlohmann::json& timings);
+nlohmann::json Provenance(const std::vector<std::string>& argv,
+                          const nlohmann::json& resolved_config, int threads,
+                          const nlohmann::json& timings);
 
 }  // namespace mmh::cli

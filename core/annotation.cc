@@ -41,7 +41,8 @@ Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
     }
     const auto fields = SplitCsvFields(content);
     if (fields.size() != 2) {
-      ThrowBadValue(where, std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
+      ThrowBadValue(where,
+                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
                     "2 fields: timestamp,value");
     }
     double timestamp = 0.0, value = 0.0;
@@ -53,9 +54,9 @@ Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
     }
     CheckValue(value, where);
     if (!annotation.timestamps.empty() && !(timestamp > annotation.timestamps.back())) {
-      ThrowBadValue(where + ", timestamp", FormatNumber(timestamp),
-                    "greater than the previous timestamp " +
-                        FormatNumber(annotation.timestamps.back()));
+      ThrowBadValue(
+          where + ", timestamp", FormatNumber(timestamp),
+          "greater than the previous timestamp " + FormatNumber(annotation.timestamps.back()));
     }
     annotation.timestamps.push_back(timestamp);
     annotation.values.push_back(value);
@@ -69,8 +70,9 @@ Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
 
 void ValidateAnnotation(const Annotation& annotation, const std::string& name) {
   if (annotation.timestamps.size() != annotation.values.size()) {
-    ThrowBadValue(name, std::to_string(annotation.timestamps.size()) + " timestamps for " +
-                            std::to_string(annotation.values.size()) + " values",
+    ThrowBadValue(name,
+                  std::to_string(annotation.timestamps.size()) + " timestamps for " +
+                      std::to_string(annotation.values.size()) + " values",
                   "one timestamp per value");
   }
   for (std::size_t i = 0; i < annotation.size(); ++i) {
@@ -91,7 +93,8 @@ void ValidateAnnotation(const Annotation& annotation, const std::string& name) {
 void WriteAnnotationCsv(const std::filesystem::path& path, const Annotation& annotation) {
   ValidateAnnotation(annotation, path.string());
   if (annotation.values.empty()) {
-    ThrowBadValue(path.string(), "an empty annotation", "at least one row (the reader rejects none)");
+    ThrowBadValue(path.string(), "an empty annotation",
+                  "at least one row (the reader rejects none)");
   }
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "timestamp,value\n";

@@ -30,7 +30,8 @@ void WriteFileAtomically(const std::filesystem::path& path,
     out.close();
     std::error_code ec;
     std::filesystem::rename(temporary, path, ec);
-    if (ec) ThrowBadValue(path.string(), "a failed rename (" + ec.message() + ")", "a writable folder");
+    if (ec)
+      ThrowBadValue(path.string(), "a failed rename (" + ec.message() + ")", "a writable folder");
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove(temporary, ignored);

@@ -17,13 +17,12 @@
 #include <concepts>
 #include <cstdint>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "core/error.h"
 
@@ -42,7 +41,7 @@ concept NamedEnum = std::is_enum_v<E> && requires(E e) {
 };
 
 template <class E>
-  requires NamedEnum<E>
+requires NamedEnum<E>
 const char* EnumName(E value) {
   for (const auto& [e, name] : EnumNames(value)) {
     if (e == value) return name;
@@ -61,7 +60,9 @@ struct FieldCollector {
 };
 
 template <class T>
-concept HasFields = requires(T& t, FieldCollector& c) { t.VisitFields(c); };
+concept HasFields = requires(T& t, FieldCollector& c) {
+  t.VisitFields(c);
+};
 
 // The closest known name within edit distance 2, or "".
 std::string SuggestName(const std::string& unknown, const std::vector<std::string>& known);

@@ -20,8 +20,9 @@ double MedianFramePeriod(const std::vector<double>& timestamps) {
 
 void ValidateTrajectory(const Trajectory& trajectory, const std::string& name) {
   if (trajectory.timestamps.size() != trajectory.poses.size()) {
-    ThrowBadValue(name, std::to_string(trajectory.timestamps.size()) + " timestamps for " +
-                            std::to_string(trajectory.poses.size()) + " poses",
+    ThrowBadValue(name,
+                  std::to_string(trajectory.timestamps.size()) + " timestamps for " +
+                      std::to_string(trajectory.poses.size()) + " poses",
                   "one timestamp per pose");
   }
   for (std::size_t i = 0; i < trajectory.size(); ++i) {
@@ -29,11 +30,12 @@ void ValidateTrajectory(const Trajectory& trajectory, const std::string& name) {
     auto where = [&] { return name + ", frame " + std::to_string(i); };
     const Rigid3& pose = trajectory.poses[i];
     const double t = trajectory.timestamps[i];
-    if (!std::isfinite(t)) ThrowBadValue(where() + ", timestamp", FormatNumber(t), "a finite number");
+    if (!std::isfinite(t))
+      ThrowBadValue(where() + ", timestamp", FormatNumber(t), "a finite number");
     if (i > 0 && !(t > trajectory.timestamps[i - 1])) {
-      ThrowBadValue(where() + ", timestamp", FormatNumber(t),
-                    "greater than the previous timestamp " +
-                        FormatNumber(trajectory.timestamps[i - 1]));
+      ThrowBadValue(
+          where() + ", timestamp", FormatNumber(t),
+          "greater than the previous timestamp " + FormatNumber(trajectory.timestamps[i - 1]));
     }
     if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite()) {
       ThrowBadValue(where(), "a non-finite pose value", "finite translation and quaternion");

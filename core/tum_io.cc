@@ -22,7 +22,8 @@ Trajectory ReadTum(const std::filesystem::path& path) {
     const std::string where = path.string() + ":" + std::to_string(line_number);
     const auto fields = SplitFields(content, " \t");
     if (fields.size() != 8) {
-      ThrowBadValue(where, std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
+      ThrowBadValue(where,
+                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
                     "8 fields: timestamp tx ty tz qx qy qz qw");
     }
     double v[8];
@@ -46,9 +47,9 @@ Trajectory ReadTum(const std::filesystem::path& path) {
     // those bits, and reading then writing a file must give it back unchanged.
     if (std::abs(norm - 1.0) > 1e-12) q.normalize();
     if (!trajectory.timestamps.empty() && !(v[0] > trajectory.timestamps.back())) {
-      ThrowBadValue(where + ", timestamp", FormatNumber(v[0]),
-                    "greater than the previous timestamp " +
-                        FormatNumber(trajectory.timestamps.back()));
+      ThrowBadValue(
+          where + ", timestamp", FormatNumber(v[0]),
+          "greater than the previous timestamp " + FormatNumber(trajectory.timestamps.back()));
     }
     trajectory.timestamps.push_back(v[0]);
     trajectory.poses.emplace_back(q, Eigen::Vector3d(v[1], v[2], v[3]));

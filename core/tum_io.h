@@ -18,7 +18,8 @@ namespace mmh {
 Trajectory ReadTum(const std::filesystem::path& path);
 
 // Writes atomically, every number in its shortest exact (round-trip) form, so that the same
-// trajectory always gives the same bytes. An empty trajectory is an InputError. `comment` lines are written after '# '.
+// trajectory always gives the same bytes. An empty trajectory is an InputError. `comment` lines are
+// written after '# '.
 void WriteTum(const std::filesystem::path& path, const Trajectory& trajectory,
               const std::string& comment = "");
 

@@ -39,8 +39,9 @@ std::vector<double> WarpAnnotation(const std::vector<double>& source_values,
   const int n = static_cast<int>(warp.size());
   const int big_n = static_cast<int>(source_values.size());
   if (n == 0 || warp.front() != 0 || warp.back() != big_n - 1) {
-    ThrowBadValue("annotation warp", "a warp of " + std::to_string(n) + " frames ending at " +
-                                         (n ? std::to_string(warp.back()) : std::string("-")),
+    ThrowBadValue("annotation warp",
+                  "a warp of " + std::to_string(n) + " frames ending at " +
+                      (n ? std::to_string(warp.back()) : std::string("-")),
                   "a warp from 0 to " + std::to_string(big_n - 1));
   }
   std::vector<double> warped(n, 0.0);

@@ -15,9 +15,7 @@ constexpr std::pair<BlendWeight, const char*> kWeightNames[] = {
 
 }  // namespace
 
-std::span<const std::pair<BlendWeight, const char*>> EnumNames(BlendWeight) {
-  return kWeightNames;
-}
+std::span<const std::pair<BlendWeight, const char*>> EnumNames(BlendWeight) { return kWeightNames; }
 
 void BlendOptions::Validate(const std::string& prefix) const {
   if (window < 1 || window % 2 == 0 || window > 1001) {
@@ -65,8 +63,7 @@ Trajectory BlendMontage(const std::vector<Trajectory>& takes,
     const MontageSegment& out = segments[j - 1];
     const MontageSegment& in = segments[j];
     // Keep neighbouring windows apart: each side of a segment uses at most (length - 1) / 2.
-    const int h =
-        std::min({half, (length(out) - 1) / 2, (length(in) - 1) / 2});
+    const int h = std::min({half, (length(out) - 1) / 2, (length(in) - 1) / 2});
     if (h < half && narrowed) ++*narrowed;
     if (h <= 0) continue;
     const Trajectory& a = takes[out.take];

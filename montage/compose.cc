@@ -1,13 +1,13 @@
 #include "montage/compose.h"
 
-#include <chrono>
-#include <cmath>
-#include <numeric>
-#include <sstream>
-
-#include <nlohmann/json.hpp>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+
+#include <chrono>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <numeric>
+#include <sstream>
 
 #include "core/error.h"
 #include "core/options.h"
@@ -26,17 +26,19 @@ std::string NameOf(const std::vector<std::string>& names, std::size_t i, const c
   return std::string(kind) + " " + std::to_string(i);
 }
 
-void ValidateInputs(const std::vector<Trajectory>& takes, const std::vector<Annotation>& annotations,
-                    const ComposeOptions& options, const std::vector<std::string>& names) {
+void ValidateInputs(const std::vector<Trajectory>& takes,
+                    const std::vector<Annotation>& annotations, const ComposeOptions& options,
+                    const std::vector<std::string>& names) {
   const int m = static_cast<int>(takes.size());
   if (m < 2) {
     ThrowBadValue("takes", std::to_string(m) + (m == 1 ? " take" : " takes"),
                   "at least 2 takes to composite (one take is already its own montage)");
   }
   if (annotations.size() != takes.size()) {
-    ThrowBadValue("annotations", std::to_string(annotations.size()) + " annotations for " +
-                                     std::to_string(m) + " takes",
-                  "one annotation per take, in the same order");
+    ThrowBadValue(
+        "annotations",
+        std::to_string(annotations.size()) + " annotations for " + std::to_string(m) + " takes",
+        "one annotation per take, in the same order");
   }
   if (options.reference_take >= m) {
     ThrowBadValue("montage.reference_take", std::to_string(options.reference_take),
@@ -130,11 +132,11 @@ Montage Compose(const std::vector<Trajectory>& takes, const std::vector<Annotati
   problem.data.resize(static_cast<std::size_t>(n) * m);
   montage.warped_annotations.resize(m);
   for (int l = 0; l < m; ++l) {
-    const int shift = ReactionShiftFrames(options.reaction_time,
-                                          MedianFramePeriod(takes[l].timestamps));
+    const int shift =
+        ReactionShiftFrames(options.reaction_time, MedianFramePeriod(takes[l].timestamps));
     const auto shifted = ShiftForReaction(annotations[l].values, shift);
-    montage.warped_annotations[l] = WarpAnnotation(shifted, montage.warps[l],
-                                                   options.annotation_warp);
+    montage.warped_annotations[l] =
+        WarpAnnotation(shifted, montage.warps[l], options.annotation_warp);
     for (int t = 0; t < n; ++t) {
       problem.data[static_cast<std::size_t>(t) * m + l] = -montage.warped_annotations[l][t];
     }
@@ -241,8 +243,8 @@ std::string SegmentsToCsv(const std::vector<MontageSegment>& segments) {
   for (std::size_t i = 0; i < segments.size(); ++i) {
     const auto& s = segments[i];
     out << i << ',' << s.take << ',' << s.reference_first << ',' << s.reference_last << ','
-        << s.source_first << ',' << s.source_last << ',' << s.montage_first << ','
-        << s.montage_last << ',' << (s.reference_last - s.reference_first + 1) << ','
+        << s.source_first << ',' << s.source_last << ',' << s.montage_first << ',' << s.montage_last
+        << ',' << (s.reference_last - s.reference_first + 1) << ','
         << (s.montage_last - s.montage_first + 1) << '\n';
   }
   return out.str();

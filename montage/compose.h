@@ -3,10 +3,9 @@
 // 9), the exact constrained labelling (eqs. 7-12), unwarp and blend.
 #pragma once
 
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "core/annotation.h"
 #include "core/trajectory.h"

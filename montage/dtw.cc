@@ -8,15 +8,8 @@
 #include <limits>
 
 #include "core/error.h"
+#include "montage/internal/pose_arrays.h"
 #include "montage/match_cost.h"
-
-// Clones of the hot loops for AVX-512 and AVX2 machines, chosen at load time; the baseline build
-// stays portable. -ffp-contract=off (CMakeLists.txt) keeps every clone's rounding identical.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define MMH_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define MMH_SIMD_CLONES
-#endif
 
 namespace mmh::montage {
 namespace {
@@ -33,26 +26,7 @@ constexpr int kBlocksPerWord = 64 / kBlock;
 
 using Clock = std::chrono::steady_clock;
 
-// Poses as structure of arrays, so that the cost loops vectorise.
-struct PoseArrays {
-  std::vector<double> qx, qy, qz, qw, tx, ty, tz;
-  PoseArrays() = default;
-  explicit PoseArrays(const Trajectory& trajectory) {
-    const std::size_t n = trajectory.size();
-    for (auto* v : {&qx, &qy, &qz, &qw, &tx, &ty, &tz}) v->resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& p = trajectory.poses[i];
-      qx[i] = p.rotation.x();
-      qy[i] = p.rotation.y();
-      qz[i] = p.rotation.z();
-      qw[i] = p.rotation.w();
-      tx[i] = p.translation.x();
-      ty[i] = p.translation.y();
-      tz[i] = p.translation.z();
-    }
-  }
-  int size() const { return static_cast<int>(qx.size()); }
-};
+using internal::PoseArrays;
 
 // out[i] = C_match(reference frame t, source frame first + i) for i < count.
 MMH_SIMD_CLONES
@@ -102,7 +76,8 @@ bool NoNewMinimum(const PoseArrays& ref, int t, const PoseArrays& src, int first
 // Lower bounds for pruning. Each block of kBlock source frames is enclosed in two balls: one in
 // R^4 around its quaternions (each taken with the sign closest to the block's first one) and one
 // in R^3 around its translations. By the triangle inequality, for every source frame s in block j
-//   C_match(A, T_src(s)) >= max(0, min(|q - c_j|, |q + c_j|) - r_j) + lambda max(0, |x - m_j| - R_j).
+//   C_match(A, T_src(s)) >= max(0, min(|q - c_j|, |q + c_j|) - r_j) + lambda max(0, |x - m_j| -
+//   R_j).
 struct BlockBalls {
   std::vector<double> cx, cy, cz, cw, rq, mx, my, mz, rt;
   // The same in single precision (radii rounded up) for the fast bound rows, and the bound on
@@ -160,7 +135,8 @@ BlockBalls MakeBlockBalls(const PoseArrays& src) {
   // Radii scaled up by 2^-20 so that the conversion (relative error <= 2^-24) never shrinks them.
   b.fcx = to_float(b.cx, 1), b.fcy = to_float(b.cy, 1), b.fcz = to_float(b.cz, 1);
   b.fcw = to_float(b.cw, 1), b.fmx = to_float(b.mx, 1), b.fmy = to_float(b.my, 1);
-  b.fmz = to_float(b.mz, 1), b.frq = to_float(b.rq, 1 + 0x1p-20), b.frt = to_float(b.rt, 1 + 0x1p-20);
+  b.fmz = to_float(b.mz, 1), b.frq = to_float(b.rq, 1 + 0x1p-20),
+  b.frt = to_float(b.rt, 1 + 0x1p-20);
   return b;
 }
 
@@ -201,8 +177,8 @@ void LowerBoundRowFloat(const PoseArrays& ref, int t, const BlockBalls& b, int f
   for (int j = first; j < last; ++j) {
     const float dx = ax - cx[j], dy = ay - cy[j], dz = az - cz[j], dw = aw - cw[j];
     const float sx = ax + cx[j], sy = ay + cy[j], sz = az + cz[j], sw = aw + cw[j];
-    const float q = std::sqrt(std::min(dx * dx + dy * dy + dz * dz + dw * dw,
-                                       sx * sx + sy * sy + sz * sz + sw * sw));
+    const float q = std::sqrt(
+        std::min(dx * dx + dy * dy + dz * dz + dw * dw, sx * sx + sy * sy + sz * sz + sw * sw));
     const float ex = atx - mx[j], ey = aty - my[j], ez = atz - mz[j];
     const float x = std::sqrt(ex * ex + ey * ey + ez * ez);
     const float lb = std::max(0.0f, q - rq[j]) + flambda * std::max(0.0f, x - rt[j]);
@@ -220,14 +196,19 @@ void StoreBelow(const double* x, int count, float* out) {
 // The literal dynamic programme (eq. 4):
 //   F(0, 0) = C(0, 0), F(0, s > 0) = inf,  F(t, s) = C(t, s) + min_{s' <= s} F(t-1, s'),
 // cost F(n-1, N-1), backtracking w(t-1) = argmin_{s' <= w(t)} F(t-1, s') (first minimum).
-// Cells of blocks marked dead are taken as +inf (never evaluated). One bit per cell records "F(t, s)
-// is a new strict prefix minimum of row t", so the argmin is the last set bit at or before w(t):
+// Cells of blocks marked dead are taken as +inf (never evaluated). One bit per cell records "F(t,
+// s) is a new strict prefix minimum of row t", so the argmin is the last set bit at or before w(t):
 // the backtracking store is n * N bits, never a matrix of doubles.
 class LiteralProgramme {
  public:
   LiteralProgramme(const PoseArrays& ref, const PoseArrays& src, double lambda)
-      : ref_(ref), src_(src), lambda_(lambda), n_(ref.size()), big_n_(src.size()),
-        blocks_((big_n_ + kBlock - 1) / kBlock), words_((big_n_ + 63) / 64) {}
+      : ref_(ref),
+        src_(src),
+        lambda_(lambda),
+        n_(ref.size()),
+        big_n_(src.size()),
+        blocks_((big_n_ + kBlock - 1) / kBlock),
+        words_((big_n_ + 63) / 64) {}
 
   // The pruning policy: `pruner.Range(t)` gives the blocks [first, last] of row t worth visiting
   // (blocks outside are +inf); `pruner.BeginRow(t, first, last)` is called before a row's visit;
@@ -254,7 +235,7 @@ class LiteralProgramme {
     live_prev_[0] = 1;
     bits_[0] = 1;
     int prev_first = 0, prev_last = 0;  // previous row: first live block, last visited block
-    double prev_tail = c0;               // its prefix minimum after prev_last
+    double prev_tail = c0;              // its prefix minimum after prev_last
     if (n_ == 1) last_f = big_n_ == 1 ? c0 : kInf;
 
     for (int t = 1; t < n_; ++t) {
@@ -397,29 +378,16 @@ double PrunedLiteral(const PoseArrays& ref, const PoseArrays& src, double lambda
     index.push_back(frames - 1);
     return index;
   };
-  auto pick = [](const PoseArrays& from, const std::vector<int>& index) {
-    PoseArrays out;
-    for (auto* v : {&out.qx, &out.qy, &out.qz, &out.qw, &out.tx, &out.ty, &out.tz}) {
-      v->resize(index.size());
-    }
-    for (std::size_t i = 0; i < index.size(); ++i) {
-      out.qx[i] = from.qx[index[i]], out.qy[i] = from.qy[index[i]];
-      out.qz[i] = from.qz[index[i]], out.qw[i] = from.qw[index[i]];
-      out.tx[i] = from.tx[index[i]], out.ty[i] = from.ty[index[i]];
-      out.tz[i] = from.tz[index[i]];
-    }
-    return out;
-  };
   const std::vector<int> ref_index = subsample(n), src_index = subsample(big_n);
-  const PoseArrays coarse_ref = pick(ref, ref_index), coarse_src = pick(src, src_index);
+  const PoseArrays coarse_ref = PoseArrays::Subset(ref, ref_index);
+  const PoseArrays coarse_src = PoseArrays::Subset(src, src_index);
   std::vector<int> coarse_warp;  // n >= 2 here, so both subsamples have >= 2 frames
   LiteralProgramme coarse(coarse_ref, coarse_src, lambda);
   NoPruning all_coarse{(coarse_src.size() + kBlock - 1) / kBlock};
   coarse.Run(all_coarse, &coarse_warp, evaluated);
   std::vector<int> band_first(n), band_last(n);
   for (int t = 0; t < n; ++t) {
-    const int i =
-        std::min(static_cast<int>(ref_index.size()) - 1, (t + kCoarse / 2) / kCoarse);
+    const int i = std::min(static_cast<int>(ref_index.size()) - 1, (t + kCoarse / 2) / kCoarse);
     const int centre = src_index[coarse_warp[i]];
     band_first[t] = std::max(0, centre - kRadius) / kBlock;
     band_last[t] = std::min(big_n - 1, centre + kRadius) / kBlock;
@@ -549,9 +517,12 @@ double Symmetric(const PoseArrays& ref, const PoseArrays& src, double lambda,
   while (t > 0 || s > 0) {
     (*warp)[t] = s;
     const std::uint8_t k = move[static_cast<std::size_t>(t) * big_n + s];
-    if (k == 0) --t, --s;
-    else if (k == 1) --t;
-    else --s;
+    if (k == 0)
+      --t, --s;
+    else if (k == 1)
+      --t;
+    else
+      --s;
   }
   (*warp)[0] = 0;
   (*warp)[n - 1] = big_n - 1;
@@ -582,18 +553,19 @@ DtwResult ComputeDtw(const Trajectory& reference, const Trajectory& source,
   const int n = static_cast<int>(reference.size());
   const int big_n = static_cast<int>(source.size());
   if (n == 0 || big_n == 0) {
-    ThrowBadValue("DTW", std::to_string(n) + " reference and " + std::to_string(big_n) +
-                             " source frames", "non-empty takes");
+    ThrowBadValue("DTW",
+                  std::to_string(n) + " reference and " + std::to_string(big_n) + " source frames",
+                  "non-empty takes");
   }
   if (n == 1 && big_n > 1) {
     ThrowBadValue("DTW", "a reference of 1 frame and a source of " + std::to_string(big_n),
                   "a warp with w(0) = 0 and w(n-1) = N-1 (eq. 3), impossible for n = 1 < N");
   }
   if (options.step_pattern == StepPattern::kSlopeLimited && big_n - 1 > 2 * (n - 1)) {
-    ThrowBadValue("DTW (step_pattern slope_limited)",
-                  "a source of " + std::to_string(big_n) + " frames for a reference of " +
-                      std::to_string(n),
-                  "a source at most 2 (n - 1) + 1 frames long");
+    ThrowBadValue(
+        "DTW (step_pattern slope_limited)",
+        "a source of " + std::to_string(big_n) + " frames for a reference of " + std::to_string(n),
+        "a source at most 2 (n - 1) + 1 frames long");
   }
   const PoseArrays ref(reference), src(source);
   DtwResult result;

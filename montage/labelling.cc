@@ -25,8 +25,9 @@ void LabellingOptions::Validate(const std::string& prefix) const {
 void ValidateLabellingProblem(const LabellingProblem& problem) {
   const int n = problem.frames, m = problem.takes;
   if (n < 1 || m < 1) {
-    ThrowBadValue("labelling problem", std::to_string(n) + " frames and " + std::to_string(m) +
-                                           " takes", "at least 1 frame and 1 take");
+    ThrowBadValue("labelling problem",
+                  std::to_string(n) + " frames and " + std::to_string(m) + " takes",
+                  "at least 1 frame and 1 take");
   }
   if (problem.data.size() != static_cast<std::size_t>(n) * m) {
     ThrowBadValue("labelling problem, data costs", std::to_string(problem.data.size()) + " entries",
@@ -35,7 +36,8 @@ void ValidateLabellingProblem(const LabellingProblem& problem) {
   const auto& tr = problem.transitions;
   if (tr.frames != n || tr.takes != m ||
       tr.values.size() != static_cast<std::size_t>(n - 1) * m * m) {
-    ThrowBadValue("labelling problem, transition costs", std::to_string(tr.values.size()) + " entries",
+    ThrowBadValue("labelling problem, transition costs",
+                  std::to_string(tr.values.size()) + " entries",
                   std::to_string(n - 1) + " x " + std::to_string(m) + " x " + std::to_string(m));
   }
   for (std::size_t i = 0; i < problem.data.size(); ++i) {

@@ -26,9 +26,8 @@ std::vector<Montage> ComposeLayered(const std::vector<LayeredObject>& objects,
     Montage montage = Compose(object.takes, object.annotations, object_options, names);
     if (i > 0 && montage.trajectory.size() != montages[0].trajectory.size()) {
       montage.summary.warnings.push_back(
-          object.name + "'s takes have " + std::to_string(object.takes[0].size()) +
-          " frames but " + objects[0].name + "'s montage has " +
-          std::to_string(montages[0].trajectory.size()));
+          object.name + "'s takes have " + std::to_string(object.takes[0].size()) + " frames but " +
+          objects[0].name + "'s montage has " + std::to_string(montages[0].trajectory.size()));
     }
     montages.push_back(std::move(montage));
   }

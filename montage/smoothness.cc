@@ -1,18 +1,13 @@
 #include "montage/smoothness.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
-#include <tbb/parallel_for.h>
-
 #include "core/error.h"
+#include "montage/internal/pose_arrays.h"
 #include "montage/match_cost.h"
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define MMH_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define MMH_SIMD_CLONES
-#endif
 
 namespace mmh::montage {
 namespace {
@@ -22,39 +17,35 @@ constexpr std::pair<WindowEdge, const char*> kEdgeNames[] = {
     {WindowEdge::kTruncatedSum, "truncated_sum"},
 };
 
-// Flat pose arrays of one take: [qx qy qz qw tx ty tz] as seven columns.
-struct Columns {
-  std::vector<double> v[7];
-  int size = 0;
-  explicit Columns(const Trajectory& take) : size(static_cast<int>(take.size())) {
-    for (auto& c : v) c.resize(size);
-    for (int i = 0; i < size; ++i) {
-      const auto& p = take.poses[i];
-      v[0][i] = p.rotation.x(), v[1][i] = p.rotation.y(), v[2][i] = p.rotation.z();
-      v[3][i] = p.rotation.w(), v[4][i] = p.translation.x(), v[5][i] = p.translation.y();
-      v[6][i] = p.translation.z();
-    }
-  }
-};
+using internal::PoseArrays;
+
+// Eq. 9's sum over the `valid` pairs of a window, with the edge rule of WindowEdge. The one place
+// that scales, so that the table and the direct evaluation round alike.
+double WindowSum(double sum, int valid, const SmoothnessOptions& options) {
+  const int full = 2 * options.half_window + 1;
+  if (options.window_edge == WindowEdge::kScaledMean && valid < full) sum = sum / valid * full;
+  return sum;
+}
 
 // out[i] = C_match(l[a + i], k[b + i]) for i < count: one diagonal of eq. 9's window. Inlined into
 // each SIMD clone of its caller (one dispatch per take pair, not per window).
-[[gnu::always_inline]] inline void DiagonalCosts(const Columns& l, int a, const Columns& k, int b, int count, double lambda,
-                   double* __restrict out) {
-  const double* __restrict ax = l.v[0].data() + a;
-  const double* __restrict ay = l.v[1].data() + a;
-  const double* __restrict az = l.v[2].data() + a;
-  const double* __restrict aw = l.v[3].data() + a;
-  const double* __restrict atx = l.v[4].data() + a;
-  const double* __restrict aty = l.v[5].data() + a;
-  const double* __restrict atz = l.v[6].data() + a;
-  const double* __restrict bx = k.v[0].data() + b;
-  const double* __restrict by = k.v[1].data() + b;
-  const double* __restrict bz = k.v[2].data() + b;
-  const double* __restrict bw = k.v[3].data() + b;
-  const double* __restrict btx = k.v[4].data() + b;
-  const double* __restrict bty = k.v[5].data() + b;
-  const double* __restrict btz = k.v[6].data() + b;
+[[gnu::always_inline]] inline void DiagonalCosts(const PoseArrays& l, int a, const PoseArrays& k,
+                                                 int b, int count, double lambda,
+                                                 double* __restrict out) {
+  const double* __restrict ax = l.qx.data() + a;
+  const double* __restrict ay = l.qy.data() + a;
+  const double* __restrict az = l.qz.data() + a;
+  const double* __restrict aw = l.qw.data() + a;
+  const double* __restrict atx = l.tx.data() + a;
+  const double* __restrict aty = l.ty.data() + a;
+  const double* __restrict atz = l.tz.data() + a;
+  const double* __restrict bx = k.qx.data() + b;
+  const double* __restrict by = k.qy.data() + b;
+  const double* __restrict bz = k.qz.data() + b;
+  const double* __restrict bw = k.qw.data() + b;
+  const double* __restrict btx = k.tx.data() + b;
+  const double* __restrict bty = k.ty.data() + b;
+  const double* __restrict btz = k.tz.data() + b;
   for (int i = 0; i < count; ++i) {
     out[i] = MatchCost(ax[i], ay[i], az[i], aw[i], atx[i], aty[i], atz[i], bx[i], by[i], bz[i],
                        bw[i], btx[i], bty[i], btz[i], lambda);
@@ -64,21 +55,18 @@ struct Columns {
 // Eq. 9 around centres cl (take l) and ck (take k, already w_k(t+1) - 1), over the valid part of
 // the window, summed in h order.
 MMH_SIMD_CLONES
-double WindowCost(const Columns& l, int cl, const Columns& k, int ck,
+double WindowCost(const PoseArrays& l, int cl, const PoseArrays& k, int ck,
                   const SmoothnessOptions& options, double* scratch) {
   const int h = options.half_window;
-  // Valid h: 0 <= cl + h < l.size and 0 <= ck + h < k.size.
+  // Valid h: 0 <= cl + h < l.size() and 0 <= ck + h < k.size().
   const int lo = std::max({-h, -cl, -ck});
-  const int hi = std::min({h, l.size - 1 - cl, k.size - 1 - ck});
+  const int hi = std::min({h, l.size() - 1 - cl, k.size() - 1 - ck});
   const int valid = hi - lo + 1;
   if (valid <= 0) return 0.0;
   DiagonalCosts(l, cl + lo, k, ck + lo, valid, options.lambda, scratch);
   double sum = 0.0;
   for (int i = 0; i < valid; ++i) sum += scratch[i];
-  if (options.window_edge == WindowEdge::kScaledMean && valid < 2 * h + 1) {
-    sum = sum / valid * (2 * h + 1);
-  }
-  return sum;
+  return WindowSum(sum, valid, options);
 }
 
 }  // namespace
@@ -102,7 +90,7 @@ namespace {
 // computed once, and every window is then summed from those values in h order, exactly as
 // WindowCost sums it: the table equals the direct evaluation to the last bit.
 MMH_SIMD_CLONES
-void FillPair(const Columns& take_l, const std::vector<int>& warp_l, const Columns& take_k,
+void FillPair(const PoseArrays& take_l, const std::vector<int>& warp_l, const PoseArrays& take_k,
               const std::vector<int>& warp_k, int l, int k, const SmoothnessOptions& options,
               TransitionCosts* table, std::vector<double>* scratch) {
   const int n = static_cast<int>(warp_l.size());
@@ -120,23 +108,20 @@ void FillPair(const Columns& take_l, const std::vector<int>& warp_l, const Colum
     }
     // Source frames a of take l (b = a - offset of take k) that any window of the run uses.
     const int lo = std::max({warp_l[t] - h, 0, offset});
-    const int hi = std::min({warp_l[end - 1] + h, take_l.size - 1, take_k.size - 1 + offset});
+    const int hi = std::min({warp_l[end - 1] + h, take_l.size() - 1, take_k.size() - 1 + offset});
     if (hi >= lo) {
       scratch->resize(hi - lo + 1);
-      DiagonalCosts(take_l, lo, take_k, lo - offset, hi - lo + 1, options.lambda,
-                    scratch->data());
+      DiagonalCosts(take_l, lo, take_k, lo - offset, hi - lo + 1, options.lambda, scratch->data());
     }
     for (int u = t; u < end; ++u) {
       const int c = warp_l[u];
       const int first = std::max({c - h, 0, offset});
-      const int last = std::min({c + h, take_l.size - 1, take_k.size - 1 + offset});
+      const int last = std::min({c + h, take_l.size() - 1, take_k.size() - 1 + offset});
       const int valid = last - first + 1;
       double sum = 0.0;
       if (valid > 0) {
         for (int a = first; a <= last; ++a) sum += (*scratch)[a - lo];
-        if (options.window_edge == WindowEdge::kScaledMean && valid < 2 * h + 1) {
-          sum = sum / valid * (2 * h + 1);
-        }
+        sum = WindowSum(sum, valid, options);
       }
       table->values[(static_cast<std::size_t>(u) * m + l) * m + k] = sum;
     }
@@ -155,7 +140,7 @@ TransitionCosts ComputeSmoothnessCosts(const std::vector<Trajectory>& takes,
   table.frames = n;
   table.takes = m;
   table.values.assign(static_cast<std::size_t>(std::max(0, n - 1)) * m * m, 0.0);
-  std::vector<Columns> columns;
+  std::vector<PoseArrays> columns;
   columns.reserve(m);
   for (const auto& take : takes) columns.emplace_back(take);
   // One task per ordered pair; each writes only its own entries, so the table is the same for any
@@ -173,7 +158,7 @@ double SmoothnessCost(const Trajectory& take_l, const std::vector<int>& warp_l,
                       const Trajectory& take_k, const std::vector<int>& warp_k, int t,
                       const SmoothnessOptions& options) {
   if (&take_l == &take_k) return 0.0;
-  const Columns l(take_l), k(take_k);
+  const PoseArrays l(take_l), k(take_k);
   std::vector<double> scratch(2 * options.half_window + 1);
   return WindowCost(l, warp_l[t], k, warp_k[t + 1] - 1, options, scratch.data());
 }

@@ -26,9 +26,9 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(out);
     for (std::size_t k = 0; k < set.takes.size(); ++k) {
       const std::string stem = "take_" + std::to_string(k + 1);
-      mmh::WriteTum(out / (stem + ".tum"), set.takes[k],
-                    "synthetic take (tools/make_example_takes, seed " +
-                        std::to_string(options.seed) + ")");
+      mmh::WriteTum(
+          out / (stem + ".tum"), set.takes[k],
+          "synthetic take (tools/make_example_takes, seed " + std::to_string(options.seed) + ")");
       mmh::WriteAnnotationCsv(out / (stem + ".csv"), set.annotations[k]);
     }
   } catch (const mmh::InputError& e) {

@@ -39,7 +39,8 @@ struct SmoothNoise {
   }
   double operator()(double u) const {
     double v = 0;
-    for (int k = 0; k < 4; ++k) v += amplitude[k] * std::sin(2 * M_PI * frequency[k] * u + phase[k]);
+    for (int k = 0; k < 4; ++k)
+      v += amplitude[k] * std::sin(2 * M_PI * frequency[k] * u + phase[k]);
     return v;
   }
 };
@@ -95,9 +96,9 @@ TakeSet MakeTakeSet(const TakeSetOptions& options) {
   const double period = 1.0 / options.frame_rate;
   const int shift = static_cast<int>(std::lround(options.reaction_time / period));
   for (int k = 0; k < options.takes; ++k) {
-    const int frames = k == 0 ? options.reference_frames
-                              : static_cast<int>(random.Uniform(options.min_frames,
-                                                                options.max_frames + 1));
+    const int frames =
+        k == 0 ? options.reference_frames
+               : static_cast<int>(random.Uniform(options.min_frames, options.max_frames + 1));
     const Style style{random.Uniform(0.005, 0.02), random.Uniform(0.05, 0.3),
                       random.Uniform(0.03, 0.08), random.Uniform(0.005, 0.02)};
     // Timing: progress u(i) integrates a positive, smoothly varying speed.
@@ -128,16 +129,16 @@ TakeSet MakeTakeSet(const TakeSetOptions& options) {
         if (u[i] > a && u[i] < b) flaw = std::max(flaw, std::sin(M_PI * (u[i] - a) / (b - a)));
       }
       pose.translation += flaw * flaw_offset;
-      pose.rotation = pose.rotation *
-                      Eigen::Quaterniond(Eigen::AngleAxisd(0.4 * flaw * std::sin(0.5 * i),
-                                                           Eigen::Vector3d::UnitY()));
+      pose.rotation =
+          pose.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(0.4 * flaw * std::sin(0.5 * i),
+                                                               Eigen::Vector3d::UnitY()));
       pose.translation += options.position_noise *
                           Eigen::Vector3d(random.Normal(), random.Normal(), random.Normal());
       const Eigen::Vector3d axis(random.Normal(), random.Normal(), random.Normal());
-      pose.rotation = (pose.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(
-                                           options.rotation_noise * axis.norm(),
-                                           axis.normalized())))
-                          .normalized();
+      pose.rotation =
+          (pose.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(
+                               options.rotation_noise * axis.norm(), axis.normalized())))
+              .normalized();
       take.timestamps.push_back(i * period);
       take.poses.push_back(pose);
       quality[i] = liking + taste(u[i]) - 7.0 * flaw;

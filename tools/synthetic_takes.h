@@ -16,14 +16,14 @@
 namespace mmh::synthetic {
 
 struct TakeSetOptions {
-  int takes = 10;                   // m
-  int reference_frames = 3000;      // frames of take 0
-  int min_frames = 2700;            // other takes: uniform in [min_frames, max_frames]
+  int takes = 10;               // m
+  int reference_frames = 3000;  // frames of take 0
+  int min_frames = 2700;        // other takes: uniform in [min_frames, max_frames]
   int max_frames = 3300;
-  double frame_rate = 30.0;         // Hz
-  double reaction_time = 0.3;       // s, delay of the recorded annotation
-  double position_noise = 0.0015;   // m, per axis
-  double rotation_noise = 0.008;    // rad, per axis
+  double frame_rate = 30.0;        // Hz
+  double reaction_time = 0.3;      // s, delay of the recorded annotation
+  double position_noise = 0.0015;  // m, per axis
+  double rotation_noise = 0.008;   // rad, per axis
   std::uint64_t seed = 1;
 };
 

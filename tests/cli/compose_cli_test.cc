@@ -81,7 +81,8 @@ TEST_F(ComposeCliTest, WritesAllOutputsAndRerunGivesSameBytes) {
   const fs::path out1 = dir_ / "out1", out2 = dir_ / "out2";
   const auto r1 = RunMmh("compose " + Inputs() + " --out " + out1.string() + " --quiet");
   ASSERT_EQ(r1.exit_code, 0) << r1.output;
-  const auto r2 = RunMmh("compose " + Inputs() + " --out " + out2.string() + " --threads 1 --quiet");
+  const auto r2 =
+      RunMmh("compose " + Inputs() + " --out " + out2.string() + " --threads 1 --quiet");
   ASSERT_EQ(r2.exit_code, 0) << r2.output;
   for (const char* name : {"montage.tum", "segments.csv", "timeline.csv", "config.resolved.json"}) {
     ASSERT_TRUE(fs::exists(out1 / name)) << name;
@@ -112,7 +113,8 @@ TEST_F(ComposeCliTest, SetOverridesReachTheResolvedConfig) {
 
 TEST_F(ComposeCliTest, MarkersWriteTheMontagePosesAndKeepTheirSpacing) {
   const fs::path out = dir_ / "out";
-  const auto r = RunMmh("compose " + Inputs() + " --out " + out.string() + " --quiet --markers 10 70");
+  const auto r =
+      RunMmh("compose " + Inputs() + " --out " + out.string() + " --quiet --markers 10 70");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Trajectory markers = ReadTum(out / "markers.tum");
   const Trajectory montage = ReadTum(out / "montage.tum");
@@ -144,35 +146,45 @@ TEST_F(ComposeCliTest, BadInputExitsTwoNamesTheProblemAndWritesNothing) {
   const std::string a0 = (dir_ / "take_0.csv").string();
   const std::string a1 = (dir_ / "take_1.csv").string();
   const std::vector<BadCase> cases = {
-      {"misspelt key", Inputs() + " --set montage.labelling.mu_=3",
+      {"misspelt key",
+       Inputs() + " --set montage.labelling.mu_=3",
        {"montage.labelling.mu_", "unknown", "did you mean 'mu'"}},
-      {"wrong type", Inputs() + " --set montage.dtw.lambda=\\\"x\\\"",
+      {"wrong type",
+       Inputs() + " --set montage.dtw.lambda=\\\"x\\\"",
        {"montage.dtw.lambda", "\"x\"", "a number"}},
-      {"out of range", Inputs() + " --set montage.blend.window=14",
+      {"out of range",
+       Inputs() + " --set montage.blend.window=14",
        {"montage.blend.window", "14", "odd"}},
-      {"unknown enum", Inputs() + " --set montage.dtw.step_pattern=diagonal",
+      {"unknown enum",
+       Inputs() + " --set montage.dtw.step_pattern=diagonal",
        {"montage.dtw.step_pattern", "diagonal", "literal"}},
-      {"unknown key in file", Inputs() + " --config " + (dir_ / "config.json").string(),
+      {"unknown key in file",
+       Inputs() + " --config " + (dir_ / "config.json").string(),
        {"config.json", "montage.labelling.dd", "unknown"}},
-      {"invalid json", Inputs() + " --config " + (dir_ / "broken.json").string(),
+      {"invalid json",
+       Inputs() + " --config " + (dir_ / "broken.json").string(),
        {"broken.json:2:"}},
       {"one take", "--takes " + t0 + " --annotations " + a0, {"at least 2 takes"}},
-      {"annotation count", "--takes " + t0 + " " + t0 + " --annotations " + a0,
+      {"annotation count",
+       "--takes " + t0 + " " + t0 + " --annotations " + a0,
        {"--annotations", "1 files for 2 takes"}},
-      {"length mismatch", "--takes " + t0 + " " + t0 + " --annotations " + a0 + " " + a1,
+      {"length mismatch",
+       "--takes " + t0 + " " + t0 + " --annotations " + a0 + " " + a1,
        {"take_1.csv", "220 rows", "200 rows"}},
-      {"nan pose", "--takes " + t0 + " " + (dir_ / "nan.tum").string() + " --annotations " + a0 +
-                       " " + a0,
+      {"nan pose",
+       "--takes " + t0 + " " + (dir_ / "nan.tum").string() + " --annotations " + a0 + " " + a0,
        {"nan.tum:2", "tx", "'nan'"}},
-      {"zero quaternion", "--takes " + t0 + " " + (dir_ / "zero_q.tum").string() +
-                              " --annotations " + a0 + " " + a0,
+      {"zero quaternion",
+       "--takes " + t0 + " " + (dir_ / "zero_q.tum").string() + " --annotations " + a0 + " " + a0,
        {"zero_q.tum:2", "zero quaternion"}},
-      {"empty file", "--takes " + t0 + " " + (dir_ / "empty.tum").string() + " --annotations " +
-                         a0 + " " + a0,
+      {"empty file",
+       "--takes " + t0 + " " + (dir_ / "empty.tum").string() + " --annotations " + a0 + " " + a0,
        {"empty.tum", "no poses"}},
-      {"missing file", "--takes " + t0 + " /nonexistent/x.tum --annotations " + a0 + " " + a0,
+      {"missing file",
+       "--takes " + t0 + " /nonexistent/x.tum --annotations " + a0 + " " + a0,
        {"/nonexistent/x.tum", "does not exist"}},
-      {"take shorter than d", Inputs() + " --set montage.labelling.min_segment_length=250",
+      {"take shorter than d",
+       Inputs() + " --set montage.labelling.min_segment_length=250",
        {"take_0.tum", "200 frames", "more than montage.labelling.min_segment_length = 250"}},
       {"unknown flag", Inputs() + " --bogus", {"bogus"}},
   };

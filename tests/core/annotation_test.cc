@@ -1,6 +1,8 @@
 // Tests of core/annotation.h: CSV round trip, header, range, timestamps, line endings.
 #include "core/annotation.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,9 +12,6 @@
 #include <random>
 #include <sstream>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -28,10 +27,10 @@ class TempDir {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::random_device rd;
-    path_ = fs::temp_directory_path() /
-            ("mmh_core_annotation_" + std::string(info ? info->name() : "x") + "_" +
-             std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" +
-             std::to_string(rd()));
+    path_ =
+        fs::temp_directory_path() /
+        ("mmh_core_annotation_" + std::string(info ? info->name() : "x") + "_" +
+         std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" + std::to_string(rd()));
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -60,7 +59,8 @@ std::string ReadBytes(const fs::path& path) {
 
 std::vector<std::string> ListDir(const fs::path& dir) {
   std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  for (const auto& entry : fs::directory_iterator(dir))
+    names.push_back(entry.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
 }

@@ -1,6 +1,8 @@
 // Tests of core/atomic_file.h: old content survives a failed write, no temporaries are left.
 #include "core/atomic_file.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,9 +14,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -30,10 +29,10 @@ class TempDir {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::random_device rd;
-    path_ = fs::temp_directory_path() /
-            ("mmh_core_atomic_" + std::string(info ? info->name() : "x") + "_" +
-             std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" +
-             std::to_string(rd()));
+    path_ =
+        fs::temp_directory_path() /
+        ("mmh_core_atomic_" + std::string(info ? info->name() : "x") + "_" +
+         std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" + std::to_string(rd()));
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -56,7 +55,8 @@ std::string ReadBytes(const fs::path& path) {
 
 std::vector<std::string> ListDir(const fs::path& dir) {
   std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  for (const auto& entry : fs::directory_iterator(dir))
+    names.push_back(entry.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
 }

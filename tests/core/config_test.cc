@@ -1,6 +1,8 @@
 // Tests of core/config.h: loading JSON files, --set overrides, Get<Options>, section checks.
 #include "core/config.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -10,9 +12,6 @@
 #include <span>
 #include <string>
 #include <utility>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -67,10 +66,10 @@ class TempDir {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::random_device rd;
-    path_ = fs::temp_directory_path() /
-            ("mmh_core_config_" + std::string(info ? info->name() : "x") + "_" +
-             std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" +
-             std::to_string(rd()));
+    path_ =
+        fs::temp_directory_path() /
+        ("mmh_core_config_" + std::string(info ? info->name() : "x") + "_" +
+         std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" + std::to_string(rd()));
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -409,8 +408,9 @@ TEST(Config, RequireOnlySectionsRejectsUnknownSection) {
   TempDir dir;
   const fs::path path = WriteText(dir / "bad.json", R"({"montage": {}, "metrcs": {}})");
   const Config config = Config::Load(path);
-  const std::string message =
-      InputErrorOf([&] { config.RequireOnlySections({"montage", "metrics"}); });
+  const std::string message = InputErrorOf([&] {
+    config.RequireOnlySections({"montage", "metrics"});
+  });
   EXPECT_THAT(message, HasSubstr(path.string()));
   EXPECT_THAT(message, HasSubstr("'metrcs'"));
   EXPECT_THAT(message, HasSubstr("did you mean 'metrics'"));

@@ -1,15 +1,15 @@
 // Tests of core/options.h: ToJson / FromJson of an Options struct with a nested struct and an enum.
 #include "core/options.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <span>
 #include <string>
 #include <utility>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -178,7 +178,8 @@ TEST(Options, NumberOutOfRangeForFloatFieldIsRejected) {
   TestOptions options;
   try {
     FromJson(json{{"gain", 1e300}}, "montage", kSource, &options);
-    EXPECT_TRUE(std::isfinite(options.gain)) << "1e300 was read into a float field as " << options.gain;
+    EXPECT_TRUE(std::isfinite(options.gain))
+        << "1e300 was read into a float field as " << options.gain;
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("'montage.gain'"));
   }
@@ -241,7 +242,8 @@ TEST(Options, UnknownEnumNameIsRejected) {
   EXPECT_THAT(message, HasSubstr("\"cubic\""));
   EXPECT_THAT(message, HasSubstr("one of linear, smoothstep"));
   // A number for an enum, and a case mismatch.
-  EXPECT_THAT(FromJsonError<TestOptions>(json{{"shape", 1}}), HasSubstr("one of linear, smoothstep"));
+  EXPECT_THAT(FromJsonError<TestOptions>(json{{"shape", 1}}),
+              HasSubstr("one of linear, smoothstep"));
   EXPECT_THAT(FromJsonError<TestOptions>(json{{"shape", "Linear"}}), HasSubstr("\"Linear\""));
 }
 
@@ -309,7 +311,8 @@ TEST(Options, SizeTAndUint64FieldsAreRead) {
     ADD_FAILURE() << "uint64 field rejected 2^64-1: " << e.what();
   }
   // Negative values are still rejected.
-  EXPECT_THAT(FromJsonError<CountOptions>(json{{"max_frames", -1}}), HasSubstr("'montage.max_frames'"));
+  EXPECT_THAT(FromJsonError<CountOptions>(json{{"max_frames", -1}}),
+              HasSubstr("'montage.max_frames'"));
 }
 
 TEST(Options, SuggestName) {

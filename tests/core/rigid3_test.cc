@@ -1,11 +1,11 @@
 // Tests of core/rigid3.h: composition, inverse, point mapping, interpolation, rotation angle.
 #include "core/rigid3.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <numbers>
 #include <random>
-
-#include <gtest/gtest.h>
 
 namespace mmh {
 namespace {
@@ -30,7 +30,8 @@ Rigid3 AxisAngle(double angle, const Eigen::Vector3d& axis, const Eigen::Vector3
 
 void ExpectMatrixNear(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b, double tol) {
   for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) EXPECT_NEAR(a(r, c), b(r, c), tol) << "at (" << r << "," << c << ")";
+    for (int c = 0; c < 4; ++c)
+      EXPECT_NEAR(a(r, c), b(r, c), tol) << "at (" << r << "," << c << ")";
   }
 }
 
@@ -62,7 +63,8 @@ TEST(Rigid3, CompositionOrderIsFrameChaining) {
   // a_T_b: translate by (1,0,0); b_T_c: rotate 90 degrees about z. A point at c's x axis (1,0,0)
   // is at (0,1,0) in b, and at (1,1,0) in a.
   const Rigid3 a_T_b(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1, 0, 0));
-  const Rigid3 b_T_c = AxisAngle(std::numbers::pi / 2, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::Zero());
+  const Rigid3 b_T_c =
+      AxisAngle(std::numbers::pi / 2, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::Zero());
   const Eigen::Vector3d p_c(1, 0, 0);
   const Eigen::Vector3d p_a = (a_T_b * b_T_c) * p_c;
   EXPECT_NEAR(p_a.x(), 1.0, 1e-15);
@@ -141,7 +143,8 @@ TEST(Rigid3, InterpolateMidpointAboutOneAxis) {
   const Rigid3 expected = AxisAngle(0.6, axis, Eigen::Vector3d(1, -2, 3));
   EXPECT_LT((mid.translation - expected.translation).norm(), 1e-15);
   EXPECT_NEAR(RotationAngle(mid.rotation, expected.rotation), 0.0, 1e-7);
-  EXPECT_TRUE(mid.rotation.toRotationMatrix().isApprox(expected.rotation.toRotationMatrix(), 1e-12));
+  EXPECT_TRUE(
+      mid.rotation.toRotationMatrix().isApprox(expected.rotation.toRotationMatrix(), 1e-12));
   EXPECT_NEAR(RotationAngle(from.rotation, mid.rotation), 0.4, 1e-12);
   EXPECT_NEAR(RotationAngle(mid.rotation, to.rotation), 0.4, 1e-12);
 
@@ -198,7 +201,8 @@ TEST(Rigid3, RotationAngle) {
   const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8).normalized();
   const Eigen::Quaterniond a(Eigen::AngleAxisd(0.4, axis));
   for (double angle : {0.1, 0.5, 1.0, std::numbers::pi / 2, 2.5, 3.0}) {
-    const Eigen::Quaterniond b = a * Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()));
+    const Eigen::Quaterniond b =
+        a * Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()));
     EXPECT_NEAR(RotationAngle(a, b), angle, 1e-12) << angle;
     EXPECT_NEAR(RotationAngle(b, a), angle, 1e-12) << angle;
   }
@@ -206,8 +210,10 @@ TEST(Rigid3, RotationAngle) {
   const Eigen::Quaterniond half_turn(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitY()));
   EXPECT_NEAR(RotationAngle(Eigen::Quaterniond::Identity(), half_turn), std::numbers::pi, 1e-7);
   // Rotations by more than pi are the same as the complementary rotation: result in [0, pi].
-  const Eigen::Quaterniond three_half(Eigen::AngleAxisd(1.5 * std::numbers::pi, Eigen::Vector3d::UnitY()));
-  EXPECT_NEAR(RotationAngle(Eigen::Quaterniond::Identity(), three_half), 0.5 * std::numbers::pi, 1e-12);
+  const Eigen::Quaterniond three_half(
+      Eigen::AngleAxisd(1.5 * std::numbers::pi, Eigen::Vector3d::UnitY()));
+  EXPECT_NEAR(RotationAngle(Eigen::Quaterniond::Identity(), three_half), 0.5 * std::numbers::pi,
+              1e-12);
 }
 
 TEST(Rigid3, RotationAngleIgnoresQuaternionSign) {

@@ -1,6 +1,8 @@
 // Tests of core/text_parsing.h and the number formatting of core/error.h.
 #include "core/text_parsing.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -11,9 +13,6 @@
 #include <random>
 #include <string>
 #include <vector>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -135,9 +134,9 @@ TEST(TextParsing, ParseDoubleRoundTripsFormatNumber) {
     ASSERT_EQ(std::memcmp(&x, &y, sizeof x), 0) << FormatNumber(x);
   }
   // Edge values.
-  for (double x : {0.0, -0.0, std::numeric_limits<double>::min(), std::numeric_limits<double>::max(),
-                   std::numeric_limits<double>::lowest(), std::numeric_limits<double>::epsilon(),
-                   0.1, 1.0 / 3.0}) {
+  for (double x : {0.0, -0.0, std::numeric_limits<double>::min(),
+                   std::numeric_limits<double>::max(), std::numeric_limits<double>::lowest(),
+                   std::numeric_limits<double>::epsilon(), 0.1, 1.0 / 3.0}) {
     double y = 0;
     ASSERT_TRUE(ParseDouble(FormatNumber(x), &y)) << FormatNumber(x);
     EXPECT_EQ(std::memcmp(&x, &y, sizeof x), 0) << FormatNumber(x);

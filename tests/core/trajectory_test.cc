@@ -1,12 +1,12 @@
 // Tests of core/trajectory.h: MedianFramePeriod and ValidateTrajectory.
 #include "core/trajectory.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <limits>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -19,9 +19,9 @@ Trajectory Uniform(std::size_t n, double period = 1.0 / 30.0) {
   Trajectory trajectory;
   for (std::size_t i = 0; i < n; ++i) {
     trajectory.timestamps.push_back(static_cast<double>(i) * period);
-    trajectory.poses.emplace_back(
-        Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * static_cast<double>(i), Eigen::Vector3d::UnitY())),
-        Eigen::Vector3d(0.001 * static_cast<double>(i), 0, 1));
+    trajectory.poses.emplace_back(Eigen::Quaterniond(Eigen::AngleAxisd(
+                                      0.01 * static_cast<double>(i), Eigen::Vector3d::UnitY())),
+                                  Eigen::Vector3d(0.001 * static_cast<double>(i), 0, 1));
   }
   return trajectory;
 }

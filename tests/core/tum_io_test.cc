@@ -1,6 +1,8 @@
 // Tests of core/tum_io.h: bit-exact round trip, comments, validation errors, atomic writing.
 #include "core/tum_io.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,9 +15,6 @@
 #include <random>
 #include <sstream>
 #include <string>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
 
 #include "core/error.h"
 
@@ -32,10 +31,9 @@ class TempDir {
     static std::atomic<int> counter{0};
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::random_device rd;
-    path_ = fs::temp_directory_path() /
-            ("mmh_core_tum_" + std::string(info ? info->name() : "x") + "_" +
-             std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" +
-             std::to_string(rd()));
+    path_ = fs::temp_directory_path() / ("mmh_core_tum_" + std::string(info ? info->name() : "x") +
+                                         "_" + std::to_string(::getpid()) + "_" +
+                                         std::to_string(counter++) + "_" + std::to_string(rd()));
     fs::create_directories(path_);
   }
   ~TempDir() {
@@ -64,7 +62,8 @@ std::string ReadBytes(const fs::path& path) {
 
 std::vector<std::string> ListDir(const fs::path& dir) {
   std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  for (const auto& entry : fs::directory_iterator(dir))
+    names.push_back(entry.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
 }
@@ -100,7 +99,8 @@ Trajectory RandomTrajectory(std::size_t n, std::uint64_t seed) {
     Eigen::Quaterniond q(normal(rng), normal(rng), normal(rng), normal(rng));
     q.normalize();
     trajectory.timestamps.push_back(t);
-    trajectory.poses.emplace_back(q, Eigen::Vector3d(normal(rng), 1e-7 * normal(rng), 1e5 * normal(rng)));
+    trajectory.poses.emplace_back(
+        q, Eigen::Vector3d(normal(rng), 1e-7 * normal(rng), 1e5 * normal(rng)));
   }
   return trajectory;
 }
@@ -142,9 +142,9 @@ TEST(TumIo, RoundTripSimpleValuesIsExact) {
   TempDir dir;
   Trajectory trajectory;
   trajectory.timestamps = {0.0, 0.1, 0.2};
-  trajectory.poses = {Rigid3::Identity(),
-                      Rigid3(Eigen::Quaterniond(0, 1, 0, 0), Eigen::Vector3d(0.1, -0.2, 0.3)),
-                      Rigid3(Eigen::Quaterniond(0.5, 0.5, -0.5, 0.5), Eigen::Vector3d(1e-300, -0.0, 3))};
+  trajectory.poses = {
+      Rigid3::Identity(), Rigid3(Eigen::Quaterniond(0, 1, 0, 0), Eigen::Vector3d(0.1, -0.2, 0.3)),
+      Rigid3(Eigen::Quaterniond(0.5, 0.5, -0.5, 0.5), Eigen::Vector3d(1e-300, -0.0, 3))};
   const fs::path path = dir / "a.tum";
   WriteTum(path, trajectory);
   ExpectBitIdentical(trajectory, ReadTum(path));
@@ -166,9 +166,9 @@ TEST(TumIo, RoundTripTimestampsAndTranslationsAreBitExact) {
   Trajectory trajectory = RandomTrajectory(500, 5);
   for (auto& pose : trajectory.poses) pose.rotation = Eigen::Quaterniond::Identity();
   trajectory.timestamps[0] = 0.1 + 0.2;  // 0.30000000000000004
-  trajectory.poses[1].translation = Eigen::Vector3d(std::numeric_limits<double>::max(),
-                                                    std::numeric_limits<double>::min(),
-                                                    std::numeric_limits<double>::denorm_min());
+  trajectory.poses[1].translation =
+      Eigen::Vector3d(std::numeric_limits<double>::max(), std::numeric_limits<double>::min(),
+                      std::numeric_limits<double>::denorm_min());
   const fs::path path = dir / "t.tum";
   WriteTum(path, trajectory);
   ExpectBitIdentical(trajectory, ReadTum(path));
@@ -446,7 +446,8 @@ TEST(TumIo, NonIncreasingTimestampsAreRejected) {
 TEST(TumIo, EmptyFileIsRejected) {
   TempDir dir;
   EXPECT_THAT(ReadTumErrorOf(dir, ""), HasSubstr((dir / "bad.tum").string()));
-  EXPECT_THAT(ReadTumErrorOf(dir, "# only a comment\n\n  \n"), HasSubstr((dir / "bad.tum").string()));
+  EXPECT_THAT(ReadTumErrorOf(dir, "# only a comment\n\n  \n"),
+              HasSubstr((dir / "bad.tum").string()));
 }
 
 TEST(TumIo, NonexistentPathIsRejected) {

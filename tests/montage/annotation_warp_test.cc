@@ -1,4 +1,6 @@
 // Oracle tests of the reaction shift and the annotation warp of eq. 6.
+#include "montage/annotation_warp.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,7 +9,6 @@
 #include <random>
 #include <vector>
 
-#include "montage/annotation_warp.h"
 #include "tests/montage/oracles.h"
 
 namespace mmh::montage {

@@ -1,5 +1,7 @@
 // Oracle tests of unwarping (paper, "Unwarping the Montage") and blending ("Motion Blending"),
 // from the contracts in blend.h.
+#include "montage/blend.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <vector>
 
 #include "core/rigid3.h"
-#include "montage/blend.h"
 #include "tests/montage/oracles.h"
 
 namespace mmh::montage {
@@ -148,7 +149,8 @@ void CheckBlend(const Case& c, const BlendOptions& options, const std::string& w
       const int j_in = std::clamp(in.source_first + (f - in.montage_first), 0, n_in - 1);
       double w = double(f - t + (options.window + 1) / 2) / double(options.window + 1);
       if (options.weight == BlendWeight::kSmoothstep) w = w * w * (3 - 2 * w);
-      const Rigid3 want = Interpolate(c.takes[out.take].poses[j_out], c.takes[in.take].poses[j_in], w);
+      const Rigid3 want =
+          Interpolate(c.takes[out.take].poses[j_out], c.takes[in.take].poses[j_in], w);
       EXPECT_TRUE(SamePose(montage.poses[f], want, 1e-9))
           << "transition into " << t << ", frame " << f << " (weight " << w << ")";
     }

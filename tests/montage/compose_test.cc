@@ -1,5 +1,7 @@
 // End-to-end tests of the compositor (paper, "Compositing the takes into the montage") and of
 // layered objects and spatial markers, with independent oracles for every stage.
+#include "montage/compose.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,7 +16,6 @@
 #include "core/annotation.h"
 #include "core/error.h"
 #include "core/rigid3.h"
-#include "montage/compose.h"
 #include "montage/layered.h"
 #include "tests/montage/oracles.h"
 
@@ -28,12 +29,12 @@ constexpr double kPi = 3.14159265358979323846;
 // The story: a smooth closed-ish 3D path with a rotating proxy.
 Rigid3 StoryPose(double s) {
   Rigid3 p;
-  p.translation = Eigen::Vector3d(0.3 * std::cos(2 * kPi * s), 0.2 * std::sin(4 * kPi * s),
-                                  1.0 + 0.05 * s);
-  p.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(1.6 * kPi * s, Eigen::Vector3d::UnitZ())) *
-                Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * std::sin(2 * kPi * s),
-                                                     Eigen::Vector3d::UnitX())))
-                   .normalized();
+  p.translation =
+      Eigen::Vector3d(0.3 * std::cos(2 * kPi * s), 0.2 * std::sin(4 * kPi * s), 1.0 + 0.05 * s);
+  p.rotation =
+      (Eigen::Quaterniond(Eigen::AngleAxisd(1.6 * kPi * s, Eigen::Vector3d::UnitZ())) *
+       Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * std::sin(2 * kPi * s), Eigen::Vector3d::UnitX())))
+          .normalized();
   return p;
 }
 
@@ -97,8 +98,7 @@ bool SameRotation(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b, doub
 }
 
 bool SamePose(const Rigid3& a, const Rigid3& b, double tol) {
-  return SameRotation(a.rotation, b.rotation, tol) &&
-         (a.translation - b.translation).norm() <= tol;
+  return SameRotation(a.rotation, b.rotation, tol) && (a.translation - b.translation).norm() <= tol;
 }
 
 // Every property of a montage that follows from the paper and the headers, with independent
@@ -171,8 +171,8 @@ void CheckMontage(const std::vector<Trajectory>& takes, const std::vector<Annota
   // Timestamps strictly increasing, at the takes' frame period.
   for (std::size_t f = 1; f < montage.trajectory.timestamps.size(); ++f) {
     ASSERT_GT(montage.trajectory.timestamps[f], montage.trajectory.timestamps[f - 1]);
-    EXPECT_NEAR(montage.trajectory.timestamps[f] - montage.trajectory.timestamps[f - 1],
-                1.0 / 30.0, 1e-6);
+    EXPECT_NEAR(montage.trajectory.timestamps[f] - montage.trajectory.timestamps[f - 1], 1.0 / 30.0,
+                1e-6);
   }
 
   // Poses farther than the half window (7) from every transition are the takes' own poses.
@@ -218,7 +218,8 @@ void CheckMontage(const std::vector<Trajectory>& takes, const std::vector<Annota
   EXPECT_EQ(sum.reaction_shift_frames, shift);
   EXPECT_TRUE(NearRel(sum.data_cost + sum.smoothness_cost, sum.total_cost))
       << sum.data_cost << " + " << sum.smoothness_cost << " vs " << sum.total_cost;
-  EXPECT_LE(sum.unconstrained_cost, sum.total_cost + 1e-9 * std::max(1.0, std::abs(sum.total_cost)));
+  EXPECT_LE(sum.unconstrained_cost,
+            sum.total_cost + 1e-9 * std::max(1.0, std::abs(sum.total_cost)));
   EXPECT_LE(sum.unconstrained_short_segments, sum.unconstrained_segments);
   int shortest_ref = std::numeric_limits<int>::max(), shortest_montage = shortest_ref;
   for (const auto& s : segs) {
@@ -228,10 +229,10 @@ void CheckMontage(const std::vector<Trajectory>& takes, const std::vector<Annota
   EXPECT_EQ(sum.shortest_segment_reference, shortest_ref);
   EXPECT_EQ(sum.shortest_segment_montage, shortest_montage);
   if (sum.unconstrained_cost != 0) {
-    EXPECT_NEAR(sum.constraint_increase_percent,
-                100.0 * (sum.total_cost - sum.unconstrained_cost) /
-                    std::abs(sum.unconstrained_cost),
-                1e-9 * std::max(1.0, std::abs(sum.constraint_increase_percent)));
+    EXPECT_NEAR(
+        sum.constraint_increase_percent,
+        100.0 * (sum.total_cost - sum.unconstrained_cost) / std::abs(sum.unconstrained_cost),
+        1e-9 * std::max(1.0, std::abs(sum.constraint_increase_percent)));
   }
 
   if (options.time_warp) {
@@ -246,17 +247,17 @@ void CheckMontage(const std::vector<Trajectory>& takes, const std::vector<Annota
         case StepPattern::kLiteral:
         case StepPattern::kSlopeLimited: {
           const int max_step = options.dtw.step_pattern == StepPattern::kLiteral ? -1 : 2;
-          EXPECT_TRUE(NearRel(sum.dtw_costs[l], oracle::MyWarpCost(takes[ref], takes[l],
-                                                                   montage.warps[l], lambda)))
-              << "take " << l;
           EXPECT_TRUE(NearRel(sum.dtw_costs[l],
-                              oracle::DtwWarpDp(takes[ref], takes[l], lambda, max_step)))
+                              oracle::MyWarpCost(takes[ref], takes[l], montage.warps[l], lambda)))
+              << "take " << l;
+          EXPECT_TRUE(
+              NearRel(sum.dtw_costs[l], oracle::DtwWarpDp(takes[ref], takes[l], lambda, max_step)))
               << "take " << l << " warp is not the eq. 4 optimum";
           break;
         }
         case StepPattern::kSymmetric:
-          EXPECT_TRUE(NearRel(sum.dtw_costs[l],
-                              oracle::DtwSymmetricDp(takes[ref], takes[l], lambda)))
+          EXPECT_TRUE(
+              NearRel(sum.dtw_costs[l], oracle::DtwSymmetricDp(takes[ref], takes[l], lambda)))
               << "take " << l;
           break;
       }
@@ -269,8 +270,8 @@ void CheckMontage(const std::vector<Trajectory>& takes, const std::vector<Annota
   p.data.resize(std::size_t(n) * m);
   for (int t = 0; t < n; ++t)
     for (int l = 0; l < m; ++l) {
-      const auto want = oracle::MyConservingWarp(oracle::MyShift(annotations[l].values, shift),
-                                                 montage.warps[l]);
+      const auto want =
+          oracle::MyConservingWarp(oracle::MyShift(annotations[l].values, shift), montage.warps[l]);
       p.data[std::size_t(t) * m + l] = -want[t];
     }
   p.trans.assign(std::size_t(n - 1) * m * m, 0.0);
@@ -310,8 +311,8 @@ TEST(Compose, EndToEndInvariantsAndOptimum) {
     for (std::size_t i = 1; i < montage.segments.size(); ++i) {
       const auto& a = montage.segments[i - 1];
       const auto& b = montage.segments[i];
-      blended_checked += a.montage_last - a.montage_first >= 14 &&
-                         b.montage_last - b.montage_first >= 14;
+      blended_checked +=
+          a.montage_last - a.montage_first >= 14 && b.montage_last - b.montage_first >= 14;
     }
     if (HasFailure()) return;
   }
@@ -375,7 +376,8 @@ TEST(Compose, LikedTakeAloneIsTheMontage) {
   std::mt19937_64 rng(5);
   for (int liked : {0, 1, 2}) {
     Scenario s = MakeScenario(rng, 3);
-    for (int l = 0; l < 3; ++l) s.annotations[l] = ConstantAnnotation(s.takes[l], l == liked ? 5.0 : -5.0);
+    for (int l = 0; l < 3; ++l)
+      s.annotations[l] = ConstantAnnotation(s.takes[l], l == liked ? 5.0 : -5.0);
     const ComposeOptions options;
     const Montage montage = Compose(s.takes, s.annotations, options);
     SCOPED_TRACE("liked take " + std::to_string(liked));
@@ -507,7 +509,7 @@ TEST(Layered, SpatialMarkers) {
   EXPECT_THROW(markers.Add("monster", 100), mmh::InputError);
   EXPECT_NO_THROW(markers.Add("monster", 160));  // exactly 60 apart
   EXPECT_NO_THROW(markers.Add("monster", 40));
-  EXPECT_NO_THROW(markers.Add("mario", 100));    // another object
+  EXPECT_NO_THROW(markers.Add("mario", 100));  // another object
   EXPECT_THROW(markers.Add("mario", -1), mmh::InputError);
   EXPECT_THROW(markers.Add("mario", 130), mmh::InputError);
 

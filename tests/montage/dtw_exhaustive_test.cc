@@ -26,7 +26,8 @@ std::string WarpString(const std::vector<int>& w) {
 }
 
 // Every w: [0,n) -> [0,N), non-decreasing, w(0) = 0, w(n-1) = N-1, steps <= max_step (< 0: any).
-void EnumerateWarps(int n, int N, int max_step, const std::function<void(const std::vector<int>&)>& f) {
+void EnumerateWarps(int n, int N, int max_step,
+                    const std::function<void(const std::vector<int>&)>& f) {
   std::vector<int> w(n);
   std::function<void(int)> rec = [&](int t) {
     if (t == n) {
@@ -115,8 +116,8 @@ TEST(DtwExhaustive, TinyProblemsAllPatterns) {
     DtwOptions options;
     if (rng() % 3 == 0) options.lambda = std::uniform_real_distribution<double>(0.0, 6.0)(rng);
     const std::string where = "rep " + std::to_string(rep) + " n=" + std::to_string(n) +
-                              " N=" + std::to_string(N) + " lambda=" +
-                              std::to_string(options.lambda);
+                              " N=" + std::to_string(N) +
+                              " lambda=" + std::to_string(options.lambda);
     SCOPED_TRACE(where);
 
     // kLiteral and kSlopeLimited: enumerate warps.
@@ -153,8 +154,8 @@ TEST(DtwExhaustive, TinyProblemsAllPatterns) {
           }
         }
         EXPECT_TRUE(NearRel(r.summary.cost, best))
-            << "pattern " << int(pattern) << " prune " << prune << ": exhaustive optimum "
-            << best << ", got " << r.summary.cost << " warp " << WarpString(r.warp);
+            << "pattern " << int(pattern) << " prune " << prune << ": exhaustive optimum " << best
+            << ", got " << r.summary.cost << " warp " << WarpString(r.warp);
         EXPECT_TRUE(NearRel(WarpCost(ref, src, r.warp, o.lambda), r.summary.cost))
             << "WarpCost(result.warp) " << WarpCost(ref, src, r.warp, o.lambda)
             << " != summary.cost " << r.summary.cost;
@@ -179,8 +180,7 @@ TEST(DtwExhaustive, TinyProblemsAllPatterns) {
       if (!IsValidWarp(r.warp, N, StepPattern::kSymmetric)) {
         if (invalid_symmetric++ == 0) {
           invalid_example = where + ": ComputeDtw(kSymmetric) warp " + WarpString(r.warp) +
-                            " rejected by IsValidWarp(.., N=" + std::to_string(N) +
-                            ", kSymmetric)";
+                            " rejected by IsValidWarp(.., N=" + std::to_string(N) + ", kSymmetric)";
         }
       }
       if (r.warp.back() != N - 1) {
@@ -235,7 +235,8 @@ TEST(DtwExhaustive, IsValidWarpMatchesDefinition) {
     }
     const bool ends = w[0] == 0 && w[n - 1] == N - 1;
     const bool literal = in_range && monotone && ends;
-    EXPECT_EQ(IsValidWarp(w, N, StepPattern::kLiteral), literal) << "N=" << N << " w=" << WarpString(w);
+    EXPECT_EQ(IsValidWarp(w, N, StepPattern::kLiteral), literal)
+        << "N=" << N << " w=" << WarpString(w);
     EXPECT_EQ(IsValidWarp(w, N, StepPattern::kSlopeLimited), literal && max2)
         << "N=" << N << " w=" << WarpString(w);
     if (HasFailure()) break;
@@ -257,8 +258,8 @@ TEST(DtwExhaustive, MediumSizesMatchTextbookDp) {
       ref = oracle::RandomTrajectory(rng, n);
       src = oracle::RandomTrajectory(rng, N);
     }
-    SCOPED_TRACE("rep " + std::to_string(rep) + " n=" + std::to_string(n) + " N=" +
-                 std::to_string(N));
+    SCOPED_TRACE("rep " + std::to_string(rep) + " n=" + std::to_string(n) +
+                 " N=" + std::to_string(N));
     DtwOptions o;
     o.step_pattern = StepPattern::kLiteral;
     DtwResult r = ComputeDtw(ref, src, o);

@@ -63,10 +63,18 @@ oracle::Problem RandomProblem(std::mt19937_64& rng, int n, int m) {
   const double constant = ureal(rng);
   for (auto& v : p.data) {
     switch (dm) {
-      case 0: v = ureal(rng); break;
-      case 1: v = uint3(rng); break;                                   // many ties
-      case 2: v = constant; break;                                     // all equal
-      default: v = (rng() % 2) ? double(uint3(rng)) : ureal(rng); break;
+      case 0:
+        v = ureal(rng);
+        break;
+      case 1:
+        v = uint3(rng);
+        break;  // many ties
+      case 2:
+        v = constant;
+        break;  // all equal
+      default:
+        v = (rng() % 2) ? double(uint3(rng)) : ureal(rng);
+        break;
     }
   }
   std::uniform_real_distribution<double> upos(0.0, 2.0);
@@ -78,10 +86,18 @@ oracle::Problem RandomProblem(std::mt19937_64& rng, int n, int m) {
         double v = 0;
         if (l != k) {
           switch (sm) {
-            case 0: v = upos(rng); break;
-            case 1: v = uint2(rng); break;
-            case 2: v = 0.0; break;
-            default: v = (rng() % 3 == 0) ? 0.0 : upos(rng) * upos(rng); break;
+            case 0:
+              v = upos(rng);
+              break;
+            case 1:
+              v = uint2(rng);
+              break;
+            case 2:
+              v = 0.0;
+              break;
+            default:
+              v = (rng() % 3 == 0) ? 0.0 : upos(rng) * upos(rng);
+              break;
           }
         }
         p.trans[(std::size_t(t) * m + l) * m + k] = v;
@@ -141,8 +157,8 @@ TEST(LabellingBruteForce, MatchesExhaustiveEnumeration) {
         << "recomputed total " << mine.total << " vs result.total_cost " << r.total_cost
         << " labels " << LabelsString(r.labels);
     EXPECT_TRUE(NearRel(mine.data, r.data_cost)) << mine.data << " vs " << r.data_cost;
-    EXPECT_TRUE(NearRel(mine.smooth, r.smoothness_cost)) << mine.smooth << " vs "
-                                                         << r.smoothness_cost;
+    EXPECT_TRUE(NearRel(mine.smooth, r.smoothness_cost))
+        << mine.smooth << " vs " << r.smoothness_cost;
     EXPECT_TRUE(NearRel(r.data_cost + r.smoothness_cost, r.total_cost))
         << r.data_cost << " + " << r.smoothness_cost << " != " << r.total_cost;
 
@@ -154,8 +170,8 @@ TEST(LabellingBruteForce, MatchesExhaustiveEnumeration) {
       EXPECT_TRUE(oracle::Feasible(r.labels, d))
           << "returned labels " << LabelsString(r.labels) << " violate d=" << d;
       EXPECT_TRUE(NearRel(r.total_cost, best_feasible))
-          << "optimum " << best_feasible << " (" << best_labels << "), got " << r.total_cost
-          << " (" << LabelsString(r.labels) << ")";
+          << "optimum " << best_feasible << " (" << best_labels << "), got " << r.total_cost << " ("
+          << LabelsString(r.labels) << ")";
     } else {
       ++checked_infeasible;
       EXPECT_FALSE(r.feasible);

@@ -3,15 +3,14 @@
 // form: brute force, textbook dynamic programmes, direct sums.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "core/rigid3.h"
 #include "core/trajectory.h"
@@ -125,9 +124,8 @@ inline double Distort(double u, double amplitude, double phase) {
 }
 
 // Samples `frames` poses along the path through a time distortion, with noise.
-inline Trajectory SampleTake(const RandomWalkPath& path, int frames, double amplitude,
-                             double phase, double noise_m, double noise_rad,
-                             std::mt19937_64& rng) {
+inline Trajectory SampleTake(const RandomWalkPath& path, int frames, double amplitude, double phase,
+                             double noise_m, double noise_rad, std::mt19937_64& rng) {
   std::normal_distribution<double> g(0.0, 1.0);
   std::vector<Rigid3> poses;
   for (int j = 0; j < frames; ++j) {
@@ -136,8 +134,8 @@ inline Trajectory SampleTake(const RandomWalkPath& path, int frames, double ampl
     p.translation += noise_m * Eigen::Vector3d(g(rng), g(rng), g(rng));
     const Eigen::Vector3d e = noise_rad * Eigen::Vector3d(g(rng), g(rng), g(rng));
     if (e.norm() > 0) {
-      p.rotation = (p.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(e.norm(), e / e.norm())))
-                       .normalized();
+      p.rotation =
+          (p.rotation * Eigen::Quaterniond(Eigen::AngleAxisd(e.norm(), e / e.norm()))).normalized();
     }
     poses.push_back(p);
   }
@@ -147,19 +145,18 @@ inline Trajectory SampleTake(const RandomWalkPath& path, int frames, double ampl
 // ---------------------------------------------------------------------------------------------
 // DTW oracles: textbook full dynamic programmes (0-based, both ends fixed).
 
-inline std::vector<double> CostMatrix(const Trajectory& ref, const Trajectory& src,
-                                      double lambda) {
+inline std::vector<double> CostMatrix(const Trajectory& ref, const Trajectory& src, double lambda) {
   const int n = int(ref.size()), N = int(src.size());
   std::vector<double> c(std::size_t(n) * N);
   for (int t = 0; t < n; ++t)
-    for (int j = 0; j < N; ++j) c[std::size_t(t) * N + j] = Cmatch(ref.poses[t], src.poses[j], lambda);
+    for (int j = 0; j < N; ++j)
+      c[std::size_t(t) * N + j] = Cmatch(ref.poses[t], src.poses[j], lambda);
   return c;
 }
 
 // kLiteral: D(t, j) = C(t, j) + min_{j' <= j} D(t-1, j') (max_step < 0: unbounded, the minimum
 // over j' <= j kept as a running prefix minimum). kSlopeLimited: max_step = 2 (j - j' in {0,1,2}).
-inline double DtwWarpDp(const Trajectory& ref, const Trajectory& src, double lambda,
-                        int max_step) {
+inline double DtwWarpDp(const Trajectory& ref, const Trajectory& src, double lambda, int max_step) {
   const int n = int(ref.size()), N = int(src.size());
   const std::vector<double> c = CostMatrix(ref, src, lambda);
   std::vector<double> prev(N, kInf), cur(N, kInf);
@@ -276,7 +273,8 @@ inline bool Feasible(const std::vector<int>& labels, int d) {
 
 // Textbook semi-Markov DP, O(n^2 m^2): V(e, l) = best cost of frames [0, e] whose last segment
 // has label l, ends at e and starts at s with e - s + 1 > d:
-//   V(e, l) = min_s [ (s == 0 ? 0 : min_{k != l} V(s-1, k) + mu C_s(s-1, k, l)) + sum_{t=s}^{e} C_d(t, l) ].
+//   V(e, l) = min_s [ (s == 0 ? 0 : min_{k != l} V(s-1, k) + mu C_s(s-1, k, l)) + sum_{t=s}^{e}
+//   C_d(t, l) ].
 // Returns +inf when no labelling is feasible.
 inline double SemiMarkovOptimum(const Problem& p, double mu, int d) {
   const int n = p.n, m = p.m;
@@ -328,7 +326,6 @@ inline std::vector<int> RandomMonotoneWarp(std::mt19937_64& rng, int n, int N) {
   for (int t = 1; t < n; ++t) w[t] = w[t - 1] + steps[t - 1];
   return w;
 }
-
 
 // value at t + shift belongs to t; the tail repeats the last value.
 inline std::vector<double> MyShift(const std::vector<double>& v, int shift) {

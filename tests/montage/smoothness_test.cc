@@ -1,4 +1,6 @@
 // Oracle: the smoothness table of eq. 9 against a direct evaluation of the formula.
+#include "montage/smoothness.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "montage/smoothness.h"
 #include "tests/montage/oracles.h"
 
 namespace mmh::montage {
@@ -27,9 +28,9 @@ TakeSet RandomSetup(std::mt19937_64& rng, int n, int m, int min_len, int max_len
   const oracle::RandomWalkPath path(rng, 200);
   for (int l = 0; l < m; ++l) {
     const int N = l == 0 ? n : std::uniform_int_distribution<int>(min_len, max_len)(rng);
-    Trajectory take = similar ? oracle::SampleTake(path, N, 0.3 * (l % 3) - 0.3, 0.7 * l, 0.003,
-                                                   0.01, rng)
-                              : oracle::RandomTrajectory(rng, N);
+    Trajectory take =
+        similar ? oracle::SampleTake(path, N, 0.3 * (l % 3) - 0.3, 0.7 * l, 0.003, 0.01, rng)
+                : oracle::RandomTrajectory(rng, N);
     s.takes.push_back(oracle::FlipSigns(take, rng, 0.3));
     if (l == 0) {
       std::vector<int> id(n);
@@ -75,16 +76,15 @@ void CheckTable(const TakeSet& s, const SmoothnessOptions& options, const std::s
         const int valid = ValidPairs(s, t, l, k, options.half_window);
         if (valid < 2 * options.half_window + 1) ++truncated_entries;
         if (valid == 0 && scaled) continue;
-        const double want = oracle::MySmoothness(s.takes[l], s.warps[l], s.takes[k], s.warps[k],
-                                                 t, options.lambda, options.half_window, scaled);
+        const double want = oracle::MySmoothness(s.takes[l], s.warps[l], s.takes[k], s.warps[k], t,
+                                                 options.lambda, options.half_window, scaled);
         EXPECT_TRUE(NearRel(got, want, 1e-12))
             << "t=" << t << " l=" << l << " k=" << k << " valid=" << valid << ": table " << got
             << ", eq. 9 " << want;
         const double direct =
             SmoothnessCost(s.takes[l], s.warps[l], s.takes[k], s.warps[k], t, options);
-        EXPECT_TRUE(NearRel(direct, want, 1e-12))
-            << "SmoothnessCost t=" << t << " l=" << l << " k=" << k << ": " << direct << " vs "
-            << want;
+        EXPECT_TRUE(NearRel(direct, want, 1e-12)) << "SmoothnessCost t=" << t << " l=" << l
+                                                  << " k=" << k << ": " << direct << " vs " << want;
         if (::testing::Test::HasFailure()) return;
       }
     }
