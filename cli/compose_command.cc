@@ -127,7 +127,8 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
               << s.seconds.labelling * 1e3 << ")\n";
     for (const auto& w : s.warnings) std::cout << "warning: " << w << '\n';
     std::cout << "written: " << out.string() << "/{montage.tum, segments.csv, timeline.csv, "
-              << "summary.json, config.resolved.json, run.json}\n";
+              << "summary.json, config.resolved.json, run.json"
+              << (marker_poses.empty() ? "" : ", markers.tum") << "}\n";
   }
 }
 
