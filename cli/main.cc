@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cli/compose_command.h"
+#include "cli/render_command.h"
 #include "core/error.h"
 
 int main(int argc, char** argv) {
@@ -15,6 +16,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", MMH_VERSION);
   mmh::cli::AddComposeCommand(app, args);
+  mmh::cli::AddRenderCommand(app, args);
+  mmh::cli::AddSensorCheckCommand(app, args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -21,9 +21,9 @@ void PinholeIntrinsics::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".fy", FormatNumber(fy), "a finite focal length > 0 px");
   }
   if (!std::isfinite(cx) || cx < -width || cx > 2.0 * width) {
-    ThrowBadValue(prefix + ".cx", FormatNumber(cx),
-                  "a principal point within one image width of the image (" +
-                      std::to_string(width) + " px)");
+    ThrowBadValue(
+        prefix + ".cx", FormatNumber(cx),
+        "a principal point within one image width of the image (" + std::to_string(width) + " px)");
   }
   if (!std::isfinite(cy) || cy < -height || cy > 2.0 * height) {
     ThrowBadValue(prefix + ".cy", FormatNumber(cy),

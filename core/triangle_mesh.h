@@ -4,12 +4,19 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string>
 
 #include "core/rigid3.h"
 
 namespace mmh {
+
+// An 8-bit sRGB colour, channel order R, G, B.
+using Rgb8 = std::array<std::uint8_t, 3>;
+
+// The colour of a face when a file gives none (LoadMesh) [sRGB].
+inline constexpr Rgb8 kDefaultMeshColor = {160, 160, 160};
 
 struct TriangleMesh {
   // #V by 3 vertex positions [m] in the mesh's own frame.
@@ -41,5 +48,24 @@ Bounds3 ComputeBounds(const TriangleMesh& mesh);
 // Checks what a renderer and a tracker rely on: at least one face, finite vertices, indices in
 // range, face_colors with one row per face. Throws InputError naming `where` and the first problem.
 void ValidateMesh(const TriangleMesh& mesh, const std::string& where);
+
+// The mesh with its vertices mapped by new_T_mesh (faces and colours unchanged).
+TriangleMesh Transformed(const TriangleMesh& mesh, const Rigid3& new_T_mesh);
+
+// Gives every face the colour `color`.
+void SetColor(TriangleMesh* mesh, const Rgb8& color);
+
+// Sum of the triangle areas [m^2].
+double SurfaceArea(const TriangleMesh& mesh);
+
+// Signed volume enclosed by the faces [m^3] (divergence theorem, sum of signed tetrahedra from the
+// origin): the volume for a closed mesh with outward faces, minus it for inward faces. For a union
+// of closed parts with disjoint interiors it is the sum of their volumes.
+double SignedVolume(const TriangleMesh& mesh);
+
+// True if every edge (by vertex index) is used once in each direction, that is by exactly two faces
+// with consistent orientation: the mesh is a union of closed, oriented surfaces. Meshes whose
+// vertices are duplicated per face (WritePly, most loaded files) are never closed by this test.
+bool IsClosed(const TriangleMesh& mesh);
 
 }  // namespace mmh

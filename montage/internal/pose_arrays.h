@@ -4,16 +4,8 @@
 
 #include <vector>
 
+#include "core/simd.h"
 #include "core/trajectory.h"
-
-// Clones of the hot loops for AVX-512 and AVX2 machines, chosen at load time; the baseline build
-// stays portable. -ffp-contract=off (CMakeLists.txt) keeps every clone's rounding identical.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define MMH_SIMD_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define MMH_SIMD_CLONES
-#endif
 
 namespace mmh::montage::internal {
 

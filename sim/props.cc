@@ -1,0 +1,470 @@
+#include "sim/props.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.h"
+#include "sim/duplo.h"
+#include "sim/primitives.h"
+
+namespace mmh::sim {
+namespace {
+
+constexpr std::pair<TableProps, const char*> kPropsNames[] = {
+    {TableProps::kNone, "none"},
+    {TableProps::kCastle, "castle"},
+};
+
+// Castle layout [m] (BuildCastle): footprint and the gap between the play area and its front.
+constexpr double kCastleWidth = 0.30;
+constexpr double kCastleDepth = 0.16;
+constexpr double kCastleGap = 0.04;
+
+constexpr Rgb8 kFloorColor = {118, 108, 96};
+constexpr Rgb8 kWallColor = {212, 206, 194};
+constexpr Rgb8 kCastleStoneColor = {160, 165, 169};  // Duplo light bluish grey
+constexpr Rgb8 kCastleDoorColor = {88, 42, 18};      // reddish brown
+constexpr Rgb8 kFlagColor = {201, 26, 9};            // red
+
+void CheckSize(const std::string& key, double value, double max) {
+  if (!std::isfinite(value) || value <= 0 || value > max) {
+    ThrowBadValue(key, FormatNumber(value), "a size in (0, " + FormatNumber(max) + "] m");
+  }
+}
+
+void AppendBox(const Eigen::Vector3d& min, const Eigen::Vector3d& max, const Rgb8& color,
+               TriangleMesh* mesh) {
+  AppendMesh(MakeBoxBetween(min, max, color), Rigid3::Identity(), mesh);
+}
+
+// Tape of `width` laid outside the rectangle [x0, x1] x [y0, y1] on the table top: four boxes that
+// touch but do not overlap.
+TriangleMesh BuildTapeOutline(double x0, double x1, double y0, double y1, double width,
+                              double thickness, const Rgb8& color) {
+  TriangleMesh mesh;
+  AppendBox({x0 - width, y0 - width, 0}, {x1 + width, y0, thickness}, color, &mesh);  // front
+  AppendBox({x0 - width, y1, 0}, {x1 + width, y1 + width, thickness}, color, &mesh);  // back
+  AppendBox({x0 - width, y0, 0}, {x0, y1, thickness}, color, &mesh);                  // left
+  AppendBox({x1, y0, 0}, {x1 + width, y1, thickness}, color, &mesh);                  // right
+  return mesh;
+}
+
+// Merlons (the raised blocks of crenellations) of `size` [m] along x from x0 to x1 at y in
+// [y0, y1], standing on z = top: as many as fit with gaps equal to their width, centred.
+void AppendMerlonsAlongX(double x0, double x1, double y0, double y1, double top, double size,
+                         TriangleMesh* mesh) {
+  const int count = static_cast<int>(std::floor((x1 - x0 + size) / (2 * size)));
+  const double start = 0.5 * (x0 + x1) - 0.5 * (2 * count - 1) * size;
+  for (int i = 0; i < count; ++i) {
+    const double x = start + 2 * i * size;
+    AppendBox({x, y0, top}, {x + size, y1, top + size}, kCastleStoneColor, mesh);
+  }
+}
+void AppendMerlonsAlongY(double x0, double x1, double y0, double y1, double top, double size,
+                         TriangleMesh* mesh) {
+  const int count = static_cast<int>(std::floor((y1 - y0 + size) / (2 * size)));
+  const double start = 0.5 * (y0 + y1) - 0.5 * (2 * count - 1) * size;
+  for (int i = 0; i < count; ++i) {
+    const double y = start + 2 * i * size;
+    AppendBox({x0, y, top}, {x1, y + size, top + size}, kCastleStoneColor, mesh);
+  }
+}
+
+// A Duplo-style castle centred on x = 0 with its front face at y = front, standing on z = 0:
+// walls 2 cm thick and 14 cm tall around a courtyard, four 5 cm square towers 20 cm tall at the
+// corners, 2 cm merlons on walls and towers, a 6 x 9 cm gate in the front wall with a door
+// recessed 8 mm, a red flag on the back-left tower. About 540 triangles.
+TriangleMesh BuildCastle(double front) {
+  constexpr double kWall = 0.02;  // wall thickness
+  constexpr double kWallHeight = 0.14;
+  constexpr double kTower = 0.05;  // tower side
+  constexpr double kTowerHeight = 0.20;
+  constexpr double kMerlon = 0.02;
+  constexpr double kGateWidth = 0.06;
+  constexpr double kGateHeight = 0.09;
+  constexpr double kDoorRecess = 0.008;
+  const double x0 = -0.5 * kCastleWidth;
+  const double x1 = 0.5 * kCastleWidth;
+  const double y0 = front;
+  const double y1 = front + kCastleDepth;
+  TriangleMesh mesh;
+
+  // Towers with a merlon on each corner of their tops.
+  for (const double tx : {x0, x1 - kTower}) {
+    for (const double ty : {y0, y1 - kTower}) {
+      AppendBox({tx, ty, 0}, {tx + kTower, ty + kTower, kTowerHeight}, kCastleStoneColor, &mesh);
+      for (const double mx : {tx, tx + kTower - kMerlon}) {
+        for (const double my : {ty, ty + kTower - kMerlon}) {
+          AppendBox({mx, my, kTowerHeight}, {mx + kMerlon, my + kMerlon, kTowerHeight + kMerlon},
+                    kCastleStoneColor, &mesh);
+        }
+      }
+    }
+  }
+  // Front wall with the gate, and the door set back in it.
+  const double wx0 = x0 + kTower;
+  const double wx1 = x1 - kTower;
+  const double gx0 = -0.5 * kGateWidth;
+  const double gx1 = 0.5 * kGateWidth;
+  AppendBox({wx0, y0, 0}, {gx0, y0 + kWall, kWallHeight}, kCastleStoneColor, &mesh);
+  AppendBox({gx1, y0, 0}, {wx1, y0 + kWall, kWallHeight}, kCastleStoneColor, &mesh);
+  AppendBox({gx0, y0, kGateHeight}, {gx1, y0 + kWall, kWallHeight}, kCastleStoneColor, &mesh);
+  AppendBox({gx0, y0 + kDoorRecess, 0}, {gx1, y0 + kWall, kGateHeight}, kCastleDoorColor, &mesh);
+  // Back and side walls.
+  AppendBox({wx0, y1 - kWall, 0}, {wx1, y1, kWallHeight}, kCastleStoneColor, &mesh);
+  const double wy0 = y0 + kTower;
+  const double wy1 = y1 - kTower;
+  AppendBox({x0, wy0, 0}, {x0 + kWall, wy1, kWallHeight}, kCastleStoneColor, &mesh);
+  AppendBox({x1 - kWall, wy0, 0}, {x1, wy1, kWallHeight}, kCastleStoneColor, &mesh);
+  // Crenellations on the walls.
+  AppendMerlonsAlongX(wx0, wx1, y0, y0 + kWall, kWallHeight, kMerlon, &mesh);
+  AppendMerlonsAlongX(wx0, wx1, y1 - kWall, y1, kWallHeight, kMerlon, &mesh);
+  AppendMerlonsAlongY(x0, x0 + kWall, wy0, wy1, kWallHeight, kMerlon, &mesh);
+  AppendMerlonsAlongY(x1 - kWall, x1, wy0, wy1, kWallHeight, kMerlon, &mesh);
+  // Flag pole and flag on the back-left tower.
+  const double px = x0 + 0.5 * kTower;
+  const double py = y1 - 0.5 * kTower;
+  constexpr double kPole = 0.004;
+  constexpr double kPoleHeight = 0.06;
+  AppendBox({px - 0.5 * kPole, py - 0.5 * kPole, kTowerHeight},
+            {px + 0.5 * kPole, py + 0.5 * kPole, kTowerHeight + kPoleHeight}, kCastleDoorColor,
+            &mesh);
+  AppendBox({px + 0.5 * kPole, py - 0.001, kTowerHeight + kPoleHeight - 0.022},
+            {px + 0.5 * kPole + 0.035, py + 0.001, kTowerHeight + kPoleHeight}, kFlagColor, &mesh);
+  return mesh;
+}
+
+// Rotation whose columns are the given orthonormal right-handed axes.
+Eigen::Quaterniond FromAxes(const Eigen::Vector3d& x, const Eigen::Vector3d& y,
+                            const Eigen::Vector3d& z) {
+  Eigen::Matrix3d m;
+  m.col(0) = x;
+  m.col(1) = y;
+  m.col(2) = z;
+  return Eigen::Quaterniond(m).normalized();
+}
+
+// The middle joint of a two-link chain of lengths l1, l2 from `base` toward `target`, on the side
+// of the base-target line that `bulge` points to. A target out of reach (too far or too near)
+// leaves the chain straight (or folded) toward it.
+Eigen::Vector3d TwoLinkJoint(const Eigen::Vector3d& base, const Eigen::Vector3d& target, double l1,
+                             double l2, const Eigen::Vector3d& bulge) {
+  const Eigen::Vector3d to_target = target - base;
+  const double reach = std::clamp(to_target.norm(), std::abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9);
+  const Eigen::Vector3d along = to_target.normalized();
+  const Eigen::Vector3d side = (bulge - bulge.dot(along) * along).normalized();
+  const double foot = (l1 * l1 - l2 * l2 + reach * reach) / (2 * reach);
+  return base + along * foot + side * std::sqrt(std::max(0.0, l1 * l1 - foot * foot));
+}
+
+// Scales a mesh's vertices by (sx, sy, sz) about its origin (orientation is kept for positive
+// factors).
+TriangleMesh Scaled(TriangleMesh mesh, const Eigen::Vector3f& factors) {
+  for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i) {
+    mesh.vertices.row(i) = mesh.vertices.row(i).cwiseProduct(factors.transpose());
+  }
+  return mesh;
+}
+
+}  // namespace
+
+std::span<const std::pair<TableProps, const char*>> EnumNames(TableProps) { return kPropsNames; }
+
+void TableSceneOptions::Validate(const std::string& prefix) const {
+  CheckSize(prefix + ".table_width", table_width, 10.0);
+  CheckSize(prefix + ".table_depth", table_depth, 10.0);
+  CheckSize(prefix + ".table_thickness", table_thickness, 0.5);
+  CheckSize(prefix + ".table_height", table_height, 3.0);
+  if (table_height <= table_thickness) {
+    ThrowBadValue(prefix + ".table_height", FormatNumber(table_height),
+                  "a height above the floor greater than table_thickness (" +
+                      FormatNumber(table_thickness) + " m)");
+  }
+  CheckSize(prefix + ".play_area_width", play_area_width, 10.0);
+  CheckSize(prefix + ".play_area_depth", play_area_depth, 10.0);
+  CheckSize(prefix + ".like_box_length", like_box_length, 10.0);
+  CheckSize(prefix + ".like_box_width", like_box_width, 10.0);
+  CheckSize(prefix + ".tape_width", tape_width, 0.1);
+  CheckSize(prefix + ".tape_thickness", tape_thickness, 0.01);
+  if (!std::isfinite(like_box_center_x)) {
+    ThrowBadValue(prefix + ".like_box_center_x", FormatNumber(like_box_center_x), "a finite x [m]");
+  }
+  if (!std::isfinite(like_box_center_y)) {
+    ThrowBadValue(prefix + ".like_box_center_y", FormatNumber(like_box_center_y), "a finite y [m]");
+  }
+  if (like_box_length <= kSliderBlockSize) {
+    ThrowBadValue(prefix + ".like_box_length", FormatNumber(like_box_length),
+                  "a length greater than the slider block (" + FormatNumber(kSliderBlockSize) +
+                      " m) so that the block can slide");
+  }
+  if (like_box_width < kSliderBlockSize) {
+    ThrowBadValue(
+        prefix + ".like_box_width", FormatNumber(like_box_width),
+        "a width of at least the slider block (" + FormatNumber(kSliderBlockSize) + " m)");
+  }
+  const double half_w = 0.5 * table_width;
+  const double half_d = 0.5 * table_depth;
+  if (0.5 * play_area_width + tape_width > half_w) {
+    ThrowBadValue(prefix + ".play_area_width", FormatNumber(play_area_width),
+                  "a play area that, with its tape, fits on the " + FormatNumber(table_width) +
+                      " m wide table");
+  }
+  if (0.5 * play_area_depth + tape_width > half_d) {
+    ThrowBadValue(prefix + ".play_area_depth", FormatNumber(play_area_depth),
+                  "a play area that, with its tape, fits on the " + FormatNumber(table_depth) +
+                      " m deep table");
+  }
+  const double box_x0 = like_box_center_x - 0.5 * like_box_length - tape_width;
+  const double box_x1 = like_box_center_x + 0.5 * like_box_length + tape_width;
+  const double box_y0 = like_box_center_y - 0.5 * like_box_width - tape_width;
+  const double box_y1 = like_box_center_y + 0.5 * like_box_width + tape_width;
+  if (box_x0 < -half_w || box_x1 > half_w) {
+    ThrowBadValue(prefix + ".like_box_center_x", FormatNumber(like_box_center_x),
+                  "a Like box that, with its tape, lies on the table (x in [" +
+                      FormatNumber(-half_w) + ", " + FormatNumber(half_w) + "] m)");
+  }
+  if (box_y0 < -half_d || box_y1 > half_d) {
+    ThrowBadValue(prefix + ".like_box_center_y", FormatNumber(like_box_center_y),
+                  "a Like box that, with its tape, lies on the table (y in [" +
+                      FormatNumber(-half_d) + ", " + FormatNumber(half_d) + "] m)");
+  }
+  const double area_x = 0.5 * play_area_width + tape_width;
+  const double area_y = 0.5 * play_area_depth + tape_width;
+  if (box_x0 < area_x && box_x1 > -area_x && box_y0 < area_y && box_y1 > -area_y) {
+    ThrowBadValue(prefix + ".like_box_center_x",
+                  FormatNumber(like_box_center_x) + " (with like_box_center_y " +
+                      FormatNumber(like_box_center_y) + ")",
+                  "a Like box (with its tape) clear of the play area (with its tape)");
+  }
+  if (backdrop && (!std::isfinite(backdrop_y) || backdrop_y < half_d || backdrop_y > 10.0)) {
+    ThrowBadValue(
+        prefix + ".backdrop_y", FormatNumber(backdrop_y),
+        "a wall behind the table: y in [table_depth / 2 = " + FormatNumber(half_d) + ", 10] m");
+  }
+  if (props == TableProps::kCastle &&
+      (0.5 * play_area_depth + kCastleGap + kCastleDepth > half_d || 0.5 * kCastleWidth > half_w)) {
+    ThrowBadValue(prefix + ".props", "\"castle\"",
+                  "a table deep enough for the castle behind the play area (table_depth >= " +
+                      FormatNumber(play_area_depth + 2 * (kCastleGap + kCastleDepth)) + " m)");
+  }
+}
+
+std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options) {
+  options.Validate("scene");
+  const double half_w = 0.5 * options.table_width;
+  const double half_d = 0.5 * options.table_depth;
+  const double floor_z = -options.table_height;
+  std::vector<NamedMesh> scene;
+
+  const double far_y = options.backdrop ? options.backdrop_y : 4.0;
+  scene.push_back(
+      {"floor", MakeBoxBetween({-2.0, -2.5, floor_z - 0.02}, {2.0, far_y, floor_z}, kFloorColor)});
+
+  TriangleMesh table = MakeBoxBetween({-half_w, -half_d, -options.table_thickness},
+                                      {half_w, half_d, 0.0}, kTableColor);
+  constexpr double kLeg = 0.05;
+  constexpr double kLegInset = 0.05;
+  for (const double sx : {-1.0, 1.0}) {
+    for (const double sy : {-1.0, 1.0}) {
+      const double cx = sx * (half_w - kLegInset - 0.5 * kLeg);
+      const double cy = sy * (half_d - kLegInset - 0.5 * kLeg);
+      AppendBox({cx - 0.5 * kLeg, cy - 0.5 * kLeg, floor_z},
+                {cx + 0.5 * kLeg, cy + 0.5 * kLeg, -options.table_thickness}, kTableColor, &table);
+    }
+  }
+  scene.push_back({"table", std::move(table)});
+
+  scene.push_back(
+      {"play_area_tape",
+       BuildTapeOutline(-0.5 * options.play_area_width, 0.5 * options.play_area_width,
+                        -0.5 * options.play_area_depth, 0.5 * options.play_area_depth,
+                        options.tape_width, options.tape_thickness, kPlayAreaTapeColor)});
+  scene.push_back(
+      {"like_box_tape",
+       BuildTapeOutline(options.like_box_center_x - 0.5 * options.like_box_length,
+                        options.like_box_center_x + 0.5 * options.like_box_length,
+                        options.like_box_center_y - 0.5 * options.like_box_width,
+                        options.like_box_center_y + 0.5 * options.like_box_width,
+                        options.tape_width, options.tape_thickness, kLikeBoxTapeColor)});
+  if (options.backdrop) {
+    scene.push_back(
+        {"backdrop", MakeBoxBetween({-1.5, options.backdrop_y, floor_z},
+                                    {1.5, options.backdrop_y + 0.05, 1.25}, kWallColor)});
+  }
+  if (options.props == TableProps::kCastle) {
+    scene.push_back({"castle", BuildCastle(0.5 * options.play_area_depth + kCastleGap)});
+  }
+  return scene;
+}
+
+TriangleMesh BuildSliderBlock() { return MakeDuploBrick("2x2", kDuploGreen); }
+
+Rigid3 LikeBoxSliderPose(const TableSceneOptions& options, double value) {
+  if (!(value >= -5.0 && value <= 5.0)) {
+    ThrowBadValue("slider value", FormatNumber(value), "a value in [-5, 5]");
+  }
+  options.Validate("scene");
+  const double travel = 0.5 * (options.like_box_length - kSliderBlockSize);
+  return Rigid3(Eigen::Quaterniond::Identity(),
+                {options.like_box_center_x + value / 5.0 * travel, options.like_box_center_y, 0.0});
+}
+
+double SliderValueFromPosition(const TableSceneOptions& options,
+                               const Eigen::Vector3d& table_p_block) {
+  const double travel = 0.5 * (options.like_box_length - kSliderBlockSize);
+  return 5.0 * (table_p_block.x() - options.like_box_center_x) / travel;
+}
+
+void HandOptions::Validate(const std::string& prefix) const {
+  auto check = [&](const char* key, double value, double lo, double hi, const char* what) {
+    if (!std::isfinite(value) || value < lo || value > hi) {
+      ThrowBadValue(prefix + "." + key, FormatNumber(value),
+                    std::string(what) + " in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "]");
+    }
+  };
+  check("scale", scale, 0.5, 2.0, "a size factor");
+  check("hand_pitch", hand_pitch, -0.5, 1.4, "a pitch below horizontal [rad]");
+  check("finger_curl", finger_curl, 0.0, 1.2, "a flexion per joint [rad]");
+  check("forearm_length", forearm_length, 0.05, 0.5, "a length [m]");
+  check("forearm_elevation", forearm_elevation, 0.0, 1.5, "an elevation above horizontal [rad]");
+  check("grip_width", grip_width, 0.01, 0.08, "a width [m]");
+  if (segments < 3 || segments > 64) {
+    ThrowBadValue(prefix + ".segments", std::to_string(segments), "an integer in [3, 64]");
+  }
+}
+
+TriangleMesh BuildHandAndForearm(const HandOptions& options) {
+  options.Validate("hand");
+  const int segments = options.segments;
+  const Rgb8 skin = kSkinColor;
+  // Built at adult size and scaled at the end, so the grip is built for grip_width / scale.
+  const double half_grip = 0.5 * options.grip_width / options.scale;
+  // Palm frame: u across the palm toward the thumb, a from the wrist to the knuckles, n out of the
+  // palm's inner face (u x a = n, right-handed).
+  const double pitch = options.hand_pitch;
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d a(0.0, -std::cos(pitch), -std::sin(pitch));
+  const Eigen::Vector3d n = u.cross(a);
+
+  // Palm [m]: width along u, length along a, thickness along n: a slab with rounded edges.
+  constexpr double kPalmWidth = 0.080;
+  constexpr double kPalmLength = 0.090;
+  constexpr double kPalmThickness = 0.026;
+  const double edge_a = 0.5 * (kPalmLength - kPalmThickness);
+  const double edge_u = 0.5 * (kPalmWidth - kPalmThickness);
+  const double edge_r = 0.5 * kPalmThickness;
+
+  // Fingers: offset along u, set-back of the knuckle along -a, radius, phalanx lengths [m]. The
+  // joints flex by 0.6, 1 and 0.8 times finger_curl, cumulatively, toward the palm side.
+  struct Finger {
+    double offset, setback, radius;
+    double lengths[3];
+  };
+  constexpr Finger kFingers[] = {
+      {0.029, 0.004, 0.0090, {0.044, 0.026, 0.020}},   // index
+      {0.010, 0.000, 0.0092, {0.048, 0.030, 0.021}},   // middle
+      {-0.009, 0.004, 0.0088, {0.045, 0.028, 0.020}},  // ring
+      {-0.027, 0.014, 0.0078, {0.036, 0.021, 0.018}},  // little
+  };
+  const double k = options.finger_curl;
+  // The last phalanx at least straight down (angle pi/2 below horizontal) so it never leans into
+  // the proxy.
+  const double joint_angles[3] = {0.6 * k, 1.6 * k,
+                                  std::max(2.4 * k, 0.5 * std::numbers::pi - pitch)};
+  auto phalanx_direction = [&](int j) {
+    return Eigen::Vector3d(a * std::cos(joint_angles[j]) + n * std::sin(joint_angles[j]));
+  };
+  const Eigen::Vector3d last_direction = phalanx_direction(2);
+  auto phalanx_radius = [](const Finger& finger, int j) {
+    return finger.radius * (1.0 - 0.07 * j);
+  };
+  // The last phalanx's length includes its rounded tip.
+  auto phalanx_length = [&](const Finger& finger, int j) {
+    return finger.lengths[j] - (j == 2 ? phalanx_radius(finger, j) : 0.0);
+  };
+
+  // Place the palm so that the middle fingertip's pad touches the proxy's front: its tip centre at
+  // y = -(half_grip + radius), kPinchDepth below the grasp point (in the grip frame's y-z plane).
+  constexpr double kPinchDepth = 0.010;
+  const Finger& middle = kFingers[1];
+  Eigen::Vector3d knuckle_to_tip = Eigen::Vector3d::Zero();
+  for (int j = 0; j < 3; ++j) knuckle_to_tip += phalanx_direction(j) * phalanx_length(middle, j);
+  const Eigen::Vector3d middle_tip(middle.offset, -(half_grip + phalanx_radius(middle, 2)),
+                                   -kPinchDepth);
+  const Eigen::Vector3d palm =
+      middle_tip - knuckle_to_tip - a * (edge_a - middle.setback) - u * middle.offset;
+
+  TriangleMesh mesh;
+  AppendMesh(
+      MakeBox({kPalmWidth - kPalmThickness, kPalmLength - kPalmThickness, kPalmThickness}, skin),
+      Rigid3(FromAxes(u, a, n), palm), &mesh);
+  for (const double s : {-1.0, 1.0}) {
+    AppendMesh(MakeCapsuleBetween(palm + s * a * edge_a - u * edge_u,
+                                  palm + s * a * edge_a + u * edge_u, edge_r, segments, skin),
+               Rigid3::Identity(), &mesh);
+    AppendMesh(MakeCapsuleBetween(palm + s * u * edge_u - a * edge_a,
+                                  palm + s * u * edge_u + a * edge_a, edge_r, segments, skin),
+               Rigid3::Identity(), &mesh);
+  }
+  // Each finger's last phalanx points down at the nominal angle with its tip's pad on the front
+  // plane (the little finger, the shortest, a little higher); the proximal and middle phalanges
+  // reach its last joint by two-link inverse kinematics, the middle joint bulging to the back of
+  // the hand. For the middle finger this is the nominal pose the palm was placed by.
+  for (const Finger& finger : kFingers) {
+    const Eigen::Vector3d knuckle = palm + a * (edge_a - finger.setback) + u * finger.offset;
+    const double tip_radius = phalanx_radius(finger, 2);
+    const double lift = &finger == &kFingers[3] ? 0.006 : 0.0;
+    const Eigen::Vector3d tip(finger.offset, -(half_grip + tip_radius), -kPinchDepth + lift);
+    const Eigen::Vector3d last_joint = tip - last_direction * phalanx_length(finger, 2);
+    const Eigen::Vector3d middle_joint =
+        TwoLinkJoint(knuckle, last_joint, phalanx_length(finger, 0), phalanx_length(finger, 1), -n);
+    AppendMesh(MakeCapsuleBetween(knuckle, middle_joint, phalanx_radius(finger, 0), segments, skin),
+               Rigid3::Identity(), &mesh);
+    AppendMesh(
+        MakeCapsuleBetween(middle_joint, last_joint, phalanx_radius(finger, 1), segments, skin),
+        Rigid3::Identity(), &mesh);
+    AppendMesh(MakeCapsuleBetween(last_joint, tip, tip_radius, segments, skin), Rigid3::Identity(),
+               &mesh);
+  }
+
+  // Thumb: the metacarpal (the thenar eminence) from the middle of the palm's +u side, then the
+  // two phalanges, reaching the proxy's back face (pad at y = +half_grip, kPinchDepth below the
+  // grasp point, a little toward +x). Two-link inverse kinematics, the knuckle bulging outward
+  // (+x) and up; a target out of reach leaves the thumb stretched toward it.
+  constexpr double kMetacarpal = 0.046;
+  constexpr double kThumbTip = 0.052;  // both phalanges, straight, to the tip's centre
+  constexpr double kThumbRadius = 0.0105;
+  const Eigen::Vector3d thumb_base = palm + u * edge_u + n * (0.5 * kPalmThickness - 0.008);
+  const Eigen::Vector3d thumb_tip(0.006, half_grip + kThumbRadius, -kPinchDepth);
+  const Eigen::Vector3d thumb_knuckle =
+      TwoLinkJoint(thumb_base, thumb_tip, kMetacarpal, kThumbTip, u + Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d thumb_end =
+      thumb_knuckle + (thumb_tip - thumb_knuckle).normalized() * kThumbTip;
+  AppendMesh(MakeCapsuleBetween(thumb_base, thumb_knuckle, 0.014, segments, skin),
+             Rigid3::Identity(), &mesh);
+  AppendMesh(MakeCapsuleBetween(thumb_knuckle, thumb_end, kThumbRadius, segments, skin),
+             Rigid3::Identity(), &mesh);
+
+  // Wrist and forearm: an oval cross-section (1.3 times wider across u than deep), 48 mm deep at
+  // the wrist and 72 mm at the far end, rising from the heel of the palm at forearm_elevation.
+  const Eigen::Vector3d wrist = palm - a * (0.5 * kPalmLength - 0.006);
+  const Eigen::Vector3d f(0.0, std::cos(options.forearm_elevation),
+                          std::sin(options.forearm_elevation));
+  const Eigen::Quaterniond forearm_rotation = FromAxes(u, f.cross(u), f);
+  const Eigen::Vector3f oval(1.3f, 1.0f, 1.0f);
+  constexpr double kWristRadius = 0.024;
+  constexpr double kElbowRadius = 0.036;
+  AppendMesh(Scaled(MakeSphere(kWristRadius, 2 * segments, skin), oval),
+             Rigid3(forearm_rotation, wrist), &mesh);
+  AppendMesh(Scaled(MakeFrustum(kWristRadius, kElbowRadius, options.forearm_length / options.scale,
+                                2 * segments, skin),
+                    oval),
+             Rigid3(forearm_rotation, wrist), &mesh);
+
+  if (options.scale != 1.0) mesh.vertices *= static_cast<float>(options.scale);
+  return mesh;
+}
+
+}  // namespace mmh::sim

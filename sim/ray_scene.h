@@ -1,0 +1,94 @@
+// Ray casting for the sensor: the static table-top scene built once, moving objects (proxy, hand,
+// slider block) as instances whose poses change per frame. Embree stays inside ray_scene.cc.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+
+namespace mmh::sim {
+
+// Object index of pixels whose ray hit nothing.
+inline constexpr uint32_t kNoObject = 0xffffffffu;
+
+// One row interval of pixels [first, last] to cast.
+struct PixelSpan {
+  int row = 0;
+  int first = 0;
+  int last = -1;
+};
+
+// Primary-ray hits of a set of pixels, #height by #width row-major; pixels outside the cast spans
+// are left untouched.
+struct HitBuffer {
+  // Depth along the optical axis [m] (the ray parameter: rays have unit z in the camera frame);
+  // +infinity where nothing was hit.
+  std::vector<float> depth;
+  // Object (index from AddObject, in adding order: static meshes and moving objects share one
+  // numbering) and face hit; kNoObject where nothing was hit.
+  std::vector<uint32_t> object;
+  std::vector<uint32_t> face;
+  // Cosine of the angle between the viewing ray and the surface normal, in [0, 1].
+  std::vector<float> cos_incidence;
+  // Unit world-frame surface normal, #pixels by 3, facing the camera.
+  std::vector<float> normal;
+
+  void Resize(int pixel_count);
+};
+
+class RayScene {
+ public:
+  // Creates the Embree device. Embree errors are reported through its error callback and thrown
+  // as std::runtime_error naming the Embree error code, never ignored.
+  RayScene();
+  ~RayScene();
+  RayScene(const RayScene&) = delete;
+  RayScene& operator=(const RayScene&) = delete;
+
+  // Adds a mesh (validated: ValidateMesh names `name`). Static meshes are placed once with
+  // world_T_mesh; moving objects start at the identity and are placed by SetPose. Returns the
+  // object index. All objects must be added before the first Commit.
+  uint32_t AddStatic(const std::string& name, const TriangleMesh& mesh, const Rigid3& world_T_mesh);
+  uint32_t AddMoving(const std::string& name, const TriangleMesh& mesh);
+
+  // Moves / hides a moving object; takes effect at the next Commit.
+  void SetPose(uint32_t object, const Rigid3& world_T_object);
+  void SetVisible(uint32_t object, bool visible);
+  // Builds the static scene's BVH the first time, then only the instances' top level: cheap.
+  void Commit();
+
+  int object_count() const;
+  const std::string& object_name(uint32_t object) const;
+  const TriangleMesh& object_mesh(uint32_t object) const;
+  bool is_moving(uint32_t object) const;
+  // World bounds of a moving object at its current pose (empty when hidden).
+  Bounds3 WorldBounds(uint32_t object) const;
+
+  // Casts the camera rays of the pixels in `spans` (pixel (u, v) looks along
+  // ((u - cx) / fx, (v - cy) / fy, 1) in the camera frame) and writes their hits into `hits`.
+  // kStatic: the static scene alone (the cache of the incremental renderer); kMoving: only the
+  // moving objects, and only hits nearer than the depth already in `hits` (the cached static hit)
+  // replace it; kAll: everything. Spans are cast in 4x4 packets; the result of a pixel does not
+  // depend on the spans or on the thread that casts it.
+  enum class Target { kAll, kStatic, kMoving };
+  void Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_camera,
+            std::span<const PixelSpan> spans, Target target, HitBuffer* hits) const;
+
+  // Number of rays cast so far (for benchmarks).
+  uint64_t rays_cast() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Spans covering the whole image.
+std::vector<PixelSpan> FullImageSpans(const PinholeIntrinsics& intrinsics);
+
+}  // namespace mmh::sim

@@ -1,0 +1,158 @@
+// One simulated recording: the table-top scene with its proxy, hand and slider block, a motion for
+// the proxy and a slider track, rendered by the Kinect model into a TUM RGB-D folder (and,
+// optionally, a fakenect dump and BOP ground truth). `mmh render` is a thin layer over this.
+//
+// Until the scripted performances exist (sim/ performance issue), the proxy follows a TUM
+// trajectory file (table_T_proxy) or a built-in demo walk, and the slider an annotation CSV or a
+// built-in sweep.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/config.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+#include "sim/kinect_sensor.h"
+#include "sim/props.h"
+
+namespace mmh::sim {
+
+std::span<const std::pair<RenderMode, const char*>> EnumNames(RenderMode);
+
+// The Kinect's placement in the table frame: at `position`, looking at `look_at`, its image x axis
+// horizontal (parallel to the table).
+struct CameraPlacement {
+  double x = 0.0, y = -0.9, z = 0.75;                        // [m]
+  double look_at_x = 0.0, look_at_y = 0.0, look_at_z = 0.0;  // [m]
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("x", x);
+    v("y", y);
+    v("z", z);
+    v("look_at_x", look_at_x);
+    v("look_at_y", look_at_y);
+    v("look_at_z", look_at_z);
+  }
+  void Validate(const std::string& prefix) const;
+  // table_T_camera (camera frame: x right, y down, z forward).
+  Rigid3 TableTCamera() const;
+};
+
+// The built-in demo walk: the proxy goes round an ellipse in the play area with a stepping bounce
+// and yaw swings, the slider sweeps between dislike and like.
+struct DemoMotionOptions {
+  double radius_x = 0.12;        // [m]
+  double radius_y = 0.07;        // [m]
+  double round_period = 8.0;     // [s] per round
+  double step_rate = 2.0;        // [steps / s]
+  double bounce_height = 0.012;  // [m]
+  double yaw_swing = 0.25;       // [rad] amplitude of the head-turn-like yaw swing
+  double slider_period = 5.0;    // [s] per sweep
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("radius_x", radius_x);
+    v("radius_y", radius_y);
+    v("round_period", round_period);
+    v("step_rate", step_rate);
+    v("bounce_height", bounce_height);
+    v("yaw_swing", yaw_swing);
+    v("slider_period", slider_period);
+  }
+  void Validate(const std::string& prefix) const;
+  Rigid3 TableTProxy(double t) const;
+  double SliderValue(double t) const;
+};
+
+struct RenderOptions {
+  int frames = 150;
+  RenderMode mode = RenderMode::kIncremental;
+  // The proxy: a Duplo assembly (.json, see configs/proxies/) or a mesh (.obj, .ply) scaled by
+  // proxy_scale (e.g. 0.001 for millimetres). Empty: the Soldier figure.
+  std::string proxy;
+  double proxy_scale = 1.0;
+  // table_T_proxy per frame (TUM); empty: the demo walk. Its rows are used in order, one per frame.
+  std::string trajectory;
+  // Slider values per frame (annotation CSV); empty: the demo sweep.
+  std::string annotation;
+  bool hand = true;
+  bool slider = true;
+  // Outputs besides the TUM RGB-D folder.
+  bool fakenect = false;
+  bool bop = false;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("frames", frames);
+    v("mode", mode);
+    v("proxy", proxy);
+    v("proxy_scale", proxy_scale);
+    v("trajectory", trajectory);
+    v("annotation", annotation);
+    v("hand", hand);
+    v("slider", slider);
+    v("fakenect", fakenect);
+    v("bop", bop);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+// Every section of a render config.
+struct RenderConfig {
+  RenderOptions render;
+  CameraPlacement camera;
+  TableSceneOptions scene;
+  HandOptions hand;
+  KinectSensorOptions sensor;
+  DemoMotionOptions motion;
+
+  static RenderConfig FromConfig(const Config& config);
+  nlohmann::json ToJson() const;
+};
+
+// The proxy's model in its own frame, from RenderOptions::proxy.
+TriangleMesh LoadProxyModel(const std::string& proxy, double scale);
+
+// The scene of one recording: static table top, proxy, hand, slider block.
+class TableTopScene {
+ public:
+  TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model);
+  // Places the proxy (and the hand holding it) and the slider block; commits the scene.
+  void SetFrame(const Rigid3& table_T_proxy, double slider_value);
+  const RayScene& scene() const { return scene_; }
+  const Rigid3& table_T_camera() const { return table_T_camera_; }
+
+ private:
+  RenderConfig config_;
+  RayScene scene_;
+  Rigid3 table_T_camera_;
+  uint32_t proxy_ = 0, hand_ = 0, slider_ = 0;
+  double grip_height_ = 0.0;  // proxy frame z of the grasp point
+};
+
+struct RenderSummary {
+  int frames = 0;
+  double seconds = 0.0;           // rendering only
+  double write_seconds = 0.0;     // encoding and writing
+  double missing_fraction = 0.0;  // mean over frames
+  SensorTimings timings;
+  nlohmann::json ToJson() const;
+};
+
+// Renders the sequence and writes `out` (a TUM RGB-D folder: rgb/, depth/, rgb.txt, depth.txt,
+// groundtruth.txt = camera_T_proxy of the depth camera, camera.json), plus model.ply (the proxy's
+// model for the tracker, metres), slider.csv (the true slider values), scene.json (camera_T_table,
+// play area and Like box: the setup's calibration), fakenect/ and bop/ when enabled. Everything is
+// read and checked before the first frame; folders appear complete or not at all.
+RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
+                             const std::function<void(int, int)>& progress = {});
+
+}  // namespace mmh::sim
