@@ -126,8 +126,12 @@ TEST(KinectSensor, BoxFrontFaceAndSilhouetteAreExact) {
       const bool outside_box = x * 0.95 < -0.05 - 2 * margin || x * 0.95 > 0.15 + 2 * margin ||
                                y * 0.95 < -0.07 - 2 * margin || y * 0.95 > 0.03 + 2 * margin;
       const uint16_t d = frame.depth[v * k.width + u];
-      if (inside) ASSERT_EQ(d, 4750) << u << "," << v;
-      if (outside_box) ASSERT_EQ(d, 10000) << u << "," << v;
+      if (inside) {
+        ASSERT_EQ(d, 4750) << u << "," << v;
+      }
+      if (outside_box) {
+        ASSERT_EQ(d, 10000) << u << "," << v;
+      }
     }
   }
 }
@@ -211,10 +215,18 @@ TEST(KinectSensor, ShadowBesideNearEdgesOnTheProjectorSide) {
   const double ir = k.fx * 0.025 * (1.0 - 1.0 / 1.5);
   for (int u = 0; u < k.width; ++u) {
     const uint16_t d = frame.depth[v * k.width + u];
-    if (u < left_edge - shadow - 1 || (u > right_edge + ir + 1)) EXPECT_EQ(d, 7500) << u;
-    if (u > left_edge - shadow + 1 && u < left_edge - 1) EXPECT_EQ(d, 0) << "shadow " << u;
-    if (u > right_edge + 1 && u < right_edge + ir - 1) EXPECT_EQ(d, 0) << "IR occlusion " << u;
-    if (u > left_edge + 1 && u < right_edge - 1) EXPECT_EQ(d, 5000) << u;
+    if (u < left_edge - shadow - 1 || (u > right_edge + ir + 1)) {
+      EXPECT_EQ(d, 7500) << u;
+    }
+    if (u > left_edge - shadow + 1 && u < left_edge - 1) {
+      EXPECT_EQ(d, 0) << "shadow " << u;
+    }
+    if (u > right_edge + 1 && u < right_edge + ir - 1) {
+      EXPECT_EQ(d, 0) << "IR occlusion " << u;
+    }
+    if (u > left_edge + 1 && u < right_edge - 1) {
+      EXPECT_EQ(d, 5000) << u;
+    }
   }
 }
 
