@@ -174,6 +174,7 @@ TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& pro
   if (depth >= 0.01 && depth <= 0.08) hand.grip_width = depth;
   if (config.render.hand) hand_ = scene_.AddMoving("hand", BuildHandAndForearm(hand));
   if (config.render.slider) slider_ = scene_.AddMoving("slider", BuildSliderBlock());
+  SetFrame(Rigid3::Identity(), 0.0);  // a valid, committed scene from the start
 }
 
 void TableTopScene::SetFrame(const Rigid3& table_T_proxy, double slider_value) {
