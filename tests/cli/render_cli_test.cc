@@ -1,0 +1,123 @@
+// End-to-end tests of `mmh render` and `mmh sensor-check` as a user runs them: the outputs a
+// tracker needs, identical bytes on a rerun, exit code 2 and no output on bad input.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/rgbd_folder.h"
+#include "core/tum_io.h"
+
+namespace mmh {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+CommandResult RunMmhCommand(const std::string& arguments) {
+  const std::string command = std::string(MMH_BINARY) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[512];
+  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
+  result.exit_code = WEXITSTATUS(pclose(pipe));
+  return result;
+}
+
+std::string Slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class RenderCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("mmh_render_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(RenderCliTest, WritesAReadableTumRgbdFolderWithGroundTruthAndIsReproducible) {
+  const std::string args =
+      " --set render.frames=4 --set scene.props=castle --set render.bop=true "
+      "--set render.fakenect=true --quiet";
+  const auto first = RunMmhCommand("render --out " + (dir_ / "a").string() + args);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const auto second = RunMmhCommand("render --threads 1 --out " + (dir_ / "b").string() + args);
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  for (const char* file :
+       {"camera.json", "groundtruth.txt", "model.ply", "slider.csv", "scene.json",
+        "config.resolved.json", "run.json", "rgb.txt", "depth.txt", "bop/scene_gt.json",
+        "bop/scene_camera.json", "bop/models/obj_000001.ply"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "a" / file)) << file;
+  }
+  EXPECT_TRUE(fs::exists(dir_ / "a.fakenect" / "INDEX.txt"));
+  RgbdFolderReader a(dir_ / "a");
+  RgbdFolderReader b(dir_ / "b");
+  ASSERT_EQ(a.size(), 4);
+  for (int i = 0; i < 4; ++i) {
+    const RgbdFrame fa = a.Read(i);
+    const RgbdFrame fb = b.Read(i);
+    EXPECT_EQ(fa.depth, fb.depth) << "frame " << i << " differs with --threads 1";
+    EXPECT_EQ(fa.rgb, fb.rgb);
+    EXPECT_GT(std::count_if(fa.depth.begin(), fa.depth.end(), [](uint16_t d) { return d > 0; }),
+              200000);
+  }
+  EXPECT_EQ(Slurp(dir_ / "a" / "groundtruth.txt"), Slurp(dir_ / "b" / "groundtruth.txt"));
+  EXPECT_EQ(ReadTum(dir_ / "a" / "groundtruth.txt").size(), 4u);
+}
+
+TEST_F(RenderCliTest, BadInputExitsWithTwoNamingTheKeyAndWritesNothing) {
+  const fs::path out = dir_ / "out";
+  auto r = RunMmhCommand("render --out " + out.string() + " --set sensor.intrinsics.fx=-1");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.output, HasSubstr("sensor.intrinsics.fx"));
+  r = RunMmhCommand("render --out " + out.string() + " --set sensor.noize=true");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.output, HasSubstr("noize"));
+  EXPECT_THAT(r.output, HasSubstr("noise"));  // did you mean
+  std::ofstream(dir_ / "proxy.json") << R"({"bricks": [{"type": "2x5", "at": [0, 0, 0], "color": "red"}]})";
+  r = RunMmhCommand("render --out " + out.string() + " --set render.proxy=\\\"" +
+                    (dir_ / "proxy.json").string() + "\\\"");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("2x5"));
+  std::ofstream(dir_ / "broken.obj") << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
+  r = RunMmhCommand("render --out " + out.string() + " --set render.proxy=\\\"" +
+                    (dir_ / "broken.obj").string() + "\\\"");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("broken.obj"));
+  EXPECT_FALSE(fs::exists(out));
+  r = RunMmhCommand("render --out /proc/mmh_cannot_write_here --set render.frames=1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
+  if (!fs::exists(fs::path(MMH_SOURCE_DIR) / "../shared/data/real-rgbd/TUM_depth.png")) {
+    GTEST_SKIP() << "real frames absent";
+  }
+  const auto r = RunMmhCommand("sensor-check --frames 1 --out " + dir_.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* column : {"TUM real", "NYU real", "SUN real", "rendered"}) {
+    EXPECT_THAT(r.output, HasSubstr(column));
+  }
+  EXPECT_TRUE(fs::exists(dir_ / "sensor_check.json"));
+}
+
+}  // namespace
+}  // namespace mmh
