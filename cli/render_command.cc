@@ -150,7 +150,10 @@ void AddRenderCommand(CLI::App& app, const std::vector<std::string>& argv) {
 
 void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) {
   auto args = std::make_shared<SensorCheckArgs>();
+  // The real frames ship beside the project (../shared/data); a clone elsewhere finds them at the
+  // workplace's fixed location.
   args->data = std::string(MMH_SOURCE_DIR) + "/../shared/data/real-rgbd";
+  if (!std::filesystem::exists(args->data)) args->data = "/work/shared/data/real-rgbd";
   CLI::App* cmd = app.add_subcommand(
       "sensor-check",
       "Depth-step law, missing pixels and noise of real Kinect frames beside rendered ones");
