@@ -22,6 +22,13 @@ std::string DescribeBadValue(const std::string& where, const std::string& value,
 [[noreturn]] void ThrowBadValue(const std::string& where, const std::string& value,
                                 const std::string& expected);
 
+// Range checks for Options::Validate: each throws InputError(DescribeBadValue(where, value, ...))
+// naming the expectation (and the unit, when given).
+void RequireFinite(double value, const std::string& where);
+void RequirePositive(double value, const std::string& where, const std::string& unit = "");
+void RequireNonNegative(double value, const std::string& where, const std::string& unit = "");
+void RequireProbability(double value, const std::string& where);
+
 // Formats a double for messages: shortest form that reads back to the same value.
 std::string FormatNumber(double value);
 

@@ -6,24 +6,9 @@
 #include "core/error.h"
 
 namespace mmh::sim {
-namespace {
-
-void RequireFinitePositive(double value, const std::string& where, const std::string& unit) {
-  if (!std::isfinite(value) || value <= 0) {
-    ThrowBadValue(where, FormatNumber(value), "a finite number > 0 " + unit);
-  }
-}
-void RequireFiniteNonNegative(double value, const std::string& where, const std::string& unit) {
-  if (!std::isfinite(value) || value < 0) {
-    ThrowBadValue(where, FormatNumber(value), "a finite number >= 0 " + unit);
-  }
-}
-
-}  // namespace
-
 void KinectCalibration::Validate(const std::string& prefix) const {
-  RequireFinitePositive(ir_focal_length, prefix + ".ir_focal_length", "px");
-  RequireFinitePositive(baseline, prefix + ".baseline", "m");
+  RequirePositive(ir_focal_length, prefix + ".ir_focal_length", "px");
+  RequirePositive(baseline, prefix + ".baseline", "m");
   if (subpixel_steps < 1 || subpixel_steps > 64) {
     ThrowBadValue(prefix + ".subpixel_steps", std::to_string(subpixel_steps),
                   "an integer in [1, 64] (Kinect v1: 8)");
@@ -47,10 +32,10 @@ double LatticeStep(double z, const KinectCalibration& calibration) {
 }
 
 void AxialNoiseModel::Validate(const std::string& prefix) const {
-  RequireFiniteNonNegative(constant, prefix + ".constant", "m");
-  RequireFiniteNonNegative(quadratic, prefix + ".quadratic", "1/m");
-  RequireFiniteNonNegative(quadratic_origin, prefix + ".quadratic_origin", "m");
-  RequireFiniteNonNegative(grazing, prefix + ".grazing", "m^1.5");
+  RequireNonNegative(constant, prefix + ".constant", "m");
+  RequireNonNegative(quadratic, prefix + ".quadratic", "1/m");
+  RequireNonNegative(quadratic_origin, prefix + ".quadratic_origin", "m");
+  RequireNonNegative(grazing, prefix + ".grazing", "m^1.5");
   if (!std::isfinite(grazing_from_deg) || grazing_from_deg < 0 || grazing_from_deg >= 90) {
     ThrowBadValue(prefix + ".grazing_from_deg", FormatNumber(grazing_from_deg),
                   "an angle in [0, 90) degrees");
@@ -68,8 +53,8 @@ double AxialNoiseModel::Sigma(double z, double theta) const {
 }
 
 void LateralNoiseModel::Validate(const std::string& prefix) const {
-  RequireFiniteNonNegative(base_px, prefix + ".base_px", "px");
-  RequireFiniteNonNegative(slope_px, prefix + ".slope_px", "px");
+  RequireNonNegative(base_px, prefix + ".base_px", "px");
+  RequireNonNegative(slope_px, prefix + ".slope_px", "px");
 }
 
 double LateralNoiseModel::Sigma(double theta) const {

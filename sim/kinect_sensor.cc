@@ -31,49 +31,37 @@ inline uint64_t Mix64(uint64_t z) {
   return z ^ (z >> 31);
 }
 
-constexpr int kGaussBits = 16;
-constexpr int kGaussSize = 1 << kGaussBits;
-
 // Standard normal quantiles at the midpoints (i + 0.5) / 2^16, rescaled to unit variance: a
 // 16-bit uniform indexes an exactly symmetric, unit-variance normal sample (tails to 4.3 sigma).
-// The same construction with 2^12 entries for the colour noise: 8-bit output makes finer
-// quantiles pointless, and the 16 KB table stays in the L1 cache.
-const std::vector<float>& SmallGaussTable() {
-  static const std::vector<float> table = [] {
-    constexpr int kSize = 1 << 12;
-    std::vector<double> q(kSize);
-    boost::math::normal_distribution<double> normal;
-    double sum_sq = 0.0;
-    for (int i = 0; i < kSize / 2; ++i) {
-      const double x = boost::math::quantile(normal, (i + 0.5) / kSize);
-      q[i] = x;
-      q[kSize - 1 - i] = -x;
-      sum_sq += 2 * x * x;
-    }
-    const double scale = 1.0 / std::sqrt(sum_sq / kSize);
-    std::vector<float> out(kSize);
-    for (int i = 0; i < kSize; ++i) out[i] = static_cast<float>(q[i] * scale);
-    return out;
-  }();
+// Standard normal quantiles at the midpoints (i + 0.5) / 2^bits, rescaled to unit variance: a
+// `bits`-bit uniform indexes an exactly symmetric, unit-variance normal sample.
+std::vector<float> NormalQuantileTable(int bits) {
+  const int size = 1 << bits;
+  std::vector<double> q(size);
+  boost::math::normal_distribution<double> normal;
+  double sum_sq = 0.0;
+  for (int i = 0; i < size / 2; ++i) {
+    const double x = boost::math::quantile(normal, (i + 0.5) / size);
+    q[i] = x;
+    q[size - 1 - i] = -x;
+    sum_sq += 2 * x * x;
+  }
+  const double scale = 1.0 / std::sqrt(sum_sq / size);
+  std::vector<float> out(size);
+  for (int i = 0; i < size; ++i) out[i] = static_cast<float>(q[i] * scale);
+  return out;
+}
+
+// Depth noise: 2^16 entries (tails to 4.3 sigma).
+const std::vector<float>& GaussTable() {
+  static const std::vector<float> table = NormalQuantileTable(16);
   return table;
 }
 
-const std::vector<float>& GaussTable() {
-  static const std::vector<float> table = [] {
-    std::vector<double> q(kGaussSize);
-    boost::math::normal_distribution<double> normal;
-    double sum_sq = 0.0;
-    for (int i = 0; i < kGaussSize / 2; ++i) {
-      const double x = boost::math::quantile(normal, (i + 0.5) / kGaussSize);
-      q[i] = x;
-      q[kGaussSize - 1 - i] = -x;
-      sum_sq += 2 * x * x;
-    }
-    const double scale = 1.0 / std::sqrt(sum_sq / kGaussSize);
-    std::vector<float> out(kGaussSize);
-    for (int i = 0; i < kGaussSize; ++i) out[i] = static_cast<float>(q[i] * scale);
-    return out;
-  }();
+// Colour noise: 2^12 entries; 8-bit output makes finer quantiles pointless, and the 16 KB table
+// stays in the L1 cache.
+const std::vector<float>& SmallGaussTable() {
+  static const std::vector<float> table = NormalQuantileTable(12);
   return table;
 }
 
@@ -87,17 +75,6 @@ double LinearToSrgb(double c) {
   return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
 }
 constexpr int kEncodeSteps = 4096;
-
-void RequireProbability(double value, const std::string& where) {
-  if (!std::isfinite(value) || value < 0 || value > 1) {
-    ThrowBadValue(where, FormatNumber(value), "a probability in [0, 1]");
-  }
-}
-void RequireNonNegative(double value, const std::string& where, const std::string& unit) {
-  if (!std::isfinite(value) || value < 0) {
-    ThrowBadValue(where, FormatNumber(value), "a finite number >= 0 " + unit);
-  }
-}
 
 // Row spans covering the union of rectangles, merged per row.
 struct Rect {
@@ -262,8 +239,8 @@ void ColorModel::Validate(const std::string& prefix) const {
                       FormatNumber(light_z) + ")",
                   "a finite non-zero direction");
   }
-  RequireNonNegative(ambient, prefix + ".ambient", "");
-  RequireNonNegative(diffuse, prefix + ".diffuse", "");
+  RequireNonNegative(ambient, prefix + ".ambient");
+  RequireNonNegative(diffuse, prefix + ".diffuse");
   if (background_gray < 0 || background_gray > 255) {
     ThrowBadValue(prefix + ".background_gray", std::to_string(background_gray),
                   "an 8-bit value in [0, 255]");
@@ -343,6 +320,7 @@ struct KinectSensor::Impl {
   std::vector<float> disparity;          // per pixel of the depth view, this frame
 
   View& depth_view() { return options.registered ? color_view : ir_view; }
+  Rigid3 ColorTDepth() { return color_view.world_T_view.Inverse() * depth_view().world_T_view; }
 
   // One row of the depth image: discontinuities, lateral noise at edges (scalar, edge pixels
   // only), then the vector part.
@@ -525,7 +503,8 @@ struct KinectSensor::Impl {
     return SpansOfRects(rects, k.height);
   }
 
-  void CopySpans(const View& from_view, std::span<const PixelSpan> spans, View& view) {
+  // Restores the cached static geometry (and colour) of `spans` in the working buffers.
+  static void RestoreSpans(std::span<const PixelSpan> spans, View& view) {
     const int width = view.intrinsics.width;
     for (const PixelSpan& s : spans) {
       const size_t a = static_cast<size_t>(s.row) * width + s.first;
@@ -537,7 +516,6 @@ struct KinectSensor::Impl {
       std::copy_n(&view.static_hits.normal[3 * a], 3 * n, &view.hits.normal[3 * a]);
       if (view.needs_color) std::copy_n(&view.static_color[3 * a], 3 * n, &view.color[3 * a]);
     }
-    (void)from_view;
   }
 
   void UpdateGeometry(View& view, RenderMode mode) {
@@ -575,22 +553,19 @@ struct KinectSensor::Impl {
       spans = MovingSpans(view);
       // Back to the cache where the previous frame differed from it.
       if (view.all_dirty) {
-        CopySpans(view, full, view);
+        RestoreSpans(full, view);
       } else {
-        CopySpans(view, view.dirty, view);
+        RestoreSpans(view.dirty, view);
       }
     }
     // Rows whose occlusion can differ from the cache: those touched now or last frame.
     std::vector<char> row_dirty(k.height, view.all_dirty || mode == RenderMode::kFull);
     for (const PixelSpan& s : view.dirty) row_dirty[s.row] = 1;
     for (const PixelSpan& s : spans) row_dirty[s.row] = 1;
+    // Other rows keep the cached occlusion: their depth equals the cache.
     std::vector<int> rows;
     for (int v = 0; v < k.height; ++v) {
-      if (row_dirty[v]) {
-        rows.push_back(v);
-      } else if (view.needs_occlusion) {
-        // Unchanged row: the cached occlusion holds (restored lazily below).
-      }
+      if (row_dirty[v]) rows.push_back(v);
     }
     auto t1 = Clock::now();
     scene->Cast(k, view.world_T_view, spans, target, &view.hits);
@@ -620,7 +595,7 @@ struct KinectSensor::Impl {
     frame->depth_scale = kTumDepthScale;
     frame->depth_intrinsics = dk;
     frame->color_intrinsics = ck;
-    frame->color_T_depth = cv.world_T_view.Inverse() * dv.world_T_view;
+    frame->color_T_depth = ColorTDepth();
     frame->depth.resize(dk.pixel_count());
     frame->rgb.resize(3 * static_cast<size_t>(ck.pixel_count()));
 
@@ -779,6 +754,13 @@ RgbdFrame KinectSensor::Render(int index, RenderMode mode) {
 }
 
 Rigid3 KinectSensor::world_T_depth_camera() const { return impl_->depth_view().world_T_view; }
+const PinholeIntrinsics& KinectSensor::depth_intrinsics() const {
+  return impl_->depth_view().intrinsics;
+}
+const PinholeIntrinsics& KinectSensor::color_intrinsics() const {
+  return impl_->color_view.intrinsics;
+}
+Rigid3 KinectSensor::color_T_depth() const { return impl_->ColorTDepth(); }
 const Rigid3& KinectSensor::world_T_camera() const { return impl_->world_T_camera; }
 const KinectSensorOptions& KinectSensor::options() const { return impl_->options; }
 const SensorTimings& KinectSensor::timings() const { return impl_->timings; }

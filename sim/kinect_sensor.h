@@ -165,6 +165,10 @@ class KinectSensor {
 
   // Pose of the depth camera in the world frame (the colour camera when registered).
   Rigid3 world_T_depth_camera() const;
+  // The geometry every rendered frame carries (RgbdFrame's fields of the same names).
+  const PinholeIntrinsics& depth_intrinsics() const;
+  const PinholeIntrinsics& color_intrinsics() const;
+  Rigid3 color_T_depth() const;
   const Rigid3& world_T_camera() const;
   const KinectSensorOptions& options() const;
   const SensorTimings& timings() const;

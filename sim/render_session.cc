@@ -27,15 +27,6 @@ constexpr std::array<std::pair<RenderMode, const char*>, 2> kRenderModeNames = {
     {RenderMode::kFull, "full"},
 }};
 
-void RequireFinite(double value, const std::string& where) {
-  if (!std::isfinite(value)) ThrowBadValue(where, FormatNumber(value), "a finite number");
-}
-void RequirePositive(double value, const std::string& where, const std::string& unit) {
-  if (!std::isfinite(value) || value <= 0) {
-    ThrowBadValue(where, FormatNumber(value), "a finite number > 0 " + unit);
-  }
-}
-
 Eigen::Quaterniond Yaw(double angle) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()));
 }
@@ -123,7 +114,7 @@ void RenderOptions::Validate(const std::string& prefix) const {
   if (frames < 1 || frames > 1000000) {
     ThrowBadValue(prefix + ".frames", std::to_string(frames), "a frame count in [1, 1000000]");
   }
-  RequirePositive(proxy_scale, prefix + ".proxy_scale", "");
+  RequirePositive(proxy_scale, prefix + ".proxy_scale");
   if (!proxy.empty() && !EndsWith(proxy, ".json") && !EndsWith(proxy, ".obj") &&
       !EndsWith(proxy, ".ply")) {
     ThrowBadValue(prefix + ".proxy", "\"" + proxy + "\"",
@@ -238,27 +229,20 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
   const Rigid3 depth_T_table = sensor.world_T_depth_camera().Inverse();
 
   RgbdCameraInfo camera;
-  RgbdFrame frame;
-  {
-    // Camera info from the sensor's own frame description.
-    table_top.SetFrame(trajectory ? trajectory->poses[0] : config.motion.TableTProxy(0),
-                       annotation ? annotation->values[0] : config.motion.SliderValue(0));
-    frame = sensor.Render(0, r.mode);
-    camera.depth_intrinsics = frame.depth_intrinsics;
-    camera.color_intrinsics = frame.color_intrinsics;
-    camera.depth_scale = frame.depth_scale;
-    camera.color_T_depth = frame.color_T_depth;
-    camera.sensor = {{"model", "mmh synthetic Kinect v1"},
-                     {"registered", config.sensor.registered},
-                     {"calibration", mmh::ToJson(config.sensor.calibration)},
-                     {"seed", config.sensor.seed}};
-  }
-  sensor.ResetTimings();
+  camera.depth_intrinsics = sensor.depth_intrinsics();
+  camera.color_intrinsics = sensor.color_intrinsics();
+  camera.depth_scale = kTumDepthScale;
+  camera.color_T_depth = sensor.color_T_depth();
+  camera.sensor = {{"model", "mmh synthetic Kinect v1"},
+                   {"registered", config.sensor.registered},
+                   {"calibration", mmh::ToJson(config.sensor.calibration)},
+                   {"seed", config.sensor.seed}};
   RgbdFolderWriter writer(out, camera);
   std::unique_ptr<FakenectWriter> fakenect;
   if (r.fakenect) fakenect = std::make_unique<FakenectWriter>(out.string() + ".fakenect");
 
   RenderSummary summary;
+  RgbdFrame frame;
   Trajectory groundtruth;
   Annotation slider_truth;
   BopFrames bop;

@@ -13,35 +13,18 @@
 #include "core/annotation.h"
 #include "core/text_parsing.h"
 #include "core/tum_io.h"
+#include "tests/test_util.h"
 
 namespace mmh {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult RunMmh(const std::string& arguments) {
-  const std::string command = std::string(MMH_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[512];
-  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WEXITSTATUS(status);
-  return result;
-}
+using test_util::RunMmh;
 
 class ComposeCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("mmh_cli_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
     fs::create_directories(dir_);
     std::mt19937_64 rng(7);
     std::normal_distribution<double> noise(0.0, 0.002);
@@ -64,8 +47,6 @@ class ComposeCliTest : public ::testing::Test {
       WriteAnnotationCsv(dir_ / ("take_" + std::to_string(k) + ".csv"), annotation);
     }
   }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string Inputs() const {
     std::string s = "--takes";
     for (int k = 0; k < 3; ++k) s += " " + (dir_ / ("take_" + std::to_string(k) + ".tum")).string();
@@ -74,7 +55,8 @@ class ComposeCliTest : public ::testing::Test {
     return s;
   }
 
-  fs::path dir_;
+  test_util::TempDir temp_;
+  const fs::path dir_ = temp_.path();
 };
 
 TEST_F(ComposeCliTest, WritesAllOutputsAndRerunGivesSameBytes) {

@@ -11,6 +11,7 @@
 
 #include "core/rgbd_folder.h"
 #include "core/tum_io.h"
+#include "tests/test_util.h"
 
 namespace mmh {
 namespace {
@@ -18,20 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
-CommandResult RunMmhCommand(const std::string& arguments) {
-  const std::string command = std::string(MMH_BINARY) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  char buffer[512];
-  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
-  result.exit_code = WEXITSTATUS(pclose(pipe));
-  return result;
-}
+using test_util::RunMmh;
 
 std::string Slurp(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -42,24 +30,17 @@ std::string Slurp(const fs::path& path) {
 
 class RenderCliTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("mmh_render_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  test_util::TempDir temp_;
+  const fs::path dir_ = temp_.path();
 };
 
 TEST_F(RenderCliTest, WritesAReadableTumRgbdFolderWithGroundTruthAndIsReproducible) {
   const std::string args =
       " --set render.frames=4 --set scene.props=castle --set render.bop=true "
       "--set render.fakenect=true --quiet";
-  const auto first = RunMmhCommand("render --out " + (dir_ / "a").string() + args);
+  const auto first = RunMmh("render --out " + (dir_ / "a").string() + args);
   ASSERT_EQ(first.exit_code, 0) << first.output;
-  const auto second = RunMmhCommand("render --threads 1 --out " + (dir_ / "b").string() + args);
+  const auto second = RunMmh("render --threads 1 --out " + (dir_ / "b").string() + args);
   ASSERT_EQ(second.exit_code, 0) << second.output;
   for (const char* file :
        {"camera.json", "groundtruth.txt", "model.ply", "slider.csv", "scene.json",
@@ -85,25 +66,26 @@ TEST_F(RenderCliTest, WritesAReadableTumRgbdFolderWithGroundTruthAndIsReproducib
 
 TEST_F(RenderCliTest, BadInputExitsWithTwoNamingTheKeyAndWritesNothing) {
   const fs::path out = dir_ / "out";
-  auto r = RunMmhCommand("render --out " + out.string() + " --set sensor.intrinsics.fx=-1");
+  auto r = RunMmh("render --out " + out.string() + " --set sensor.intrinsics.fx=-1");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.output, HasSubstr("sensor.intrinsics.fx"));
-  r = RunMmhCommand("render --out " + out.string() + " --set sensor.noize=true");
+  r = RunMmh("render --out " + out.string() + " --set sensor.noize=true");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.output, HasSubstr("noize"));
   EXPECT_THAT(r.output, HasSubstr("noise"));  // did you mean
-  std::ofstream(dir_ / "proxy.json") << R"({"bricks": [{"type": "2x5", "at": [0, 0, 0], "color": "red"}]})";
-  r = RunMmhCommand("render --out " + out.string() + " --set render.proxy=\\\"" +
-                    (dir_ / "proxy.json").string() + "\\\"");
+  std::ofstream(dir_ / "proxy.json")
+      << R"({"bricks": [{"type": "2x5", "at": [0, 0, 0], "color": "red"}]})";
+  r = RunMmh("render --out " + out.string() + " --set render.proxy=\\\"" +
+             (dir_ / "proxy.json").string() + "\\\"");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("2x5"));
   std::ofstream(dir_ / "broken.obj") << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
-  r = RunMmhCommand("render --out " + out.string() + " --set render.proxy=\\\"" +
-                    (dir_ / "broken.obj").string() + "\\\"");
+  r = RunMmh("render --out " + out.string() + " --set render.proxy=\\\"" +
+             (dir_ / "broken.obj").string() + "\\\"");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("broken.obj"));
   EXPECT_FALSE(fs::exists(out));
-  r = RunMmhCommand("render --out /proc/mmh_cannot_write_here --set render.frames=1");
+  r = RunMmh("render --out /proc/mmh_cannot_write_here --set render.frames=1");
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
@@ -112,7 +94,7 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
       !fs::exists("/work/shared/data/real-rgbd/TUM_depth.png")) {
     GTEST_SKIP() << "real frames absent";
   }
-  const auto r = RunMmhCommand("sensor-check --frames 1 --out " + dir_.string());
+  const auto r = RunMmh("sensor-check --frames 1 --out " + dir_.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* column : {"TUM real", "NYU real", "SUN real", "rendered"}) {
     EXPECT_THAT(r.output, HasSubstr(column));

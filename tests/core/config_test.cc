@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "core/error.h"
+#include "tests/test_util.h"
 
 namespace mmh::config_test {
 namespace {
@@ -60,27 +61,7 @@ struct MontageOptions {
   }
 };
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::random_device rd;
-    path_ =
-        fs::temp_directory_path() /
-        ("mmh_core_config_" + std::string(info ? info->name() : "x") + "_" +
-         std::to_string(::getpid()) + "_" + std::to_string(counter++) + "_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
+using test_util::TempDir;
 
 fs::path WriteText(const fs::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "tests/test_util.h"
 
 namespace mmh {
 namespace {
@@ -29,26 +30,7 @@ using ::testing::HasSubstr;
 // The real sample frames of DESIGN.md ("Kinect v1 model"), outside the repository.
 const fs::path kRealRgbd = "/work/shared/data/real-rgbd";
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("mmh_image_io_" + std::to_string(::getpid()) + "_" +
-                                         std::to_string(counter++) + "_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::permissions(path_, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(path_, ec);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using test_util::TempDir;
 
 std::string ReadBytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

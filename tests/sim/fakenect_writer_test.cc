@@ -21,6 +21,7 @@
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "tests/test_util.h"
 
 namespace mmh::sim {
 namespace {
@@ -31,24 +32,7 @@ using ::testing::HasSubstr;
 constexpr const char* kFakenectLibrary = "/usr/lib/x86_64-linux-gnu/fakenect/libfreenect.so.0.5";
 constexpr size_t kPixels = 640 * 480;
 
-class TempDir {
- public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("mmh_fakenect_" + std::to_string(::getpid()) + "_" +
-                                         std::to_string(counter++) + "_" + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
+using test_util::TempDir;
 
 std::string ReadBytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -1,0 +1,64 @@
+// Helpers shared by the test suites: a fresh temporary folder per use, and running the mmh binary
+// as a user would.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <system_error>
+
+namespace mmh::test_util {
+
+// A new, empty folder under the system's temporary folder, named after the running test; removed
+// (with anything a test made read-only in it) when the object goes.
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("mmh_" + std::string(info ? info->test_suite_name() : "test") + "_" +
+             std::string(info ? info->name() : "x") + "_" + std::to_string(::getpid()) + "_" +
+             std::to_string(counter++) + "_" + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
+                                 std::filesystem::perm_options::add, ec);
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr
+};
+
+// Runs `mmh ARGUMENTS` (the binary under test, MMH_BINARY) through the shell.
+inline CommandResult RunMmh(const std::string& arguments) {
+  const std::string command = std::string(MMH_BINARY) + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[512];
+  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
+  result.exit_code = WEXITSTATUS(pclose(pipe));
+  return result;
+}
+
+}  // namespace mmh::test_util
