@@ -19,14 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
+using test_util::ReadBytes;
 using test_util::RunMmh;
-
-std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 class RenderCliTest : public ::testing::Test {
  protected:
@@ -60,7 +54,7 @@ TEST_F(RenderCliTest, WritesAReadableTumRgbdFolderWithGroundTruthAndIsReproducib
     EXPECT_GT(std::count_if(fa.depth.begin(), fa.depth.end(), [](uint16_t d) { return d > 0; }),
               200000);
   }
-  EXPECT_EQ(Slurp(dir_ / "a" / "groundtruth.txt"), Slurp(dir_ / "b" / "groundtruth.txt"));
+  EXPECT_EQ(ReadBytes(dir_ / "a" / "groundtruth.txt"), ReadBytes(dir_ / "b" / "groundtruth.txt"));
   EXPECT_EQ(ReadTum(dir_ / "a" / "groundtruth.txt").size(), 4u);
 }
 

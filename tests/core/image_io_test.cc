@@ -30,14 +30,9 @@ using ::testing::HasSubstr;
 // The real sample frames of DESIGN.md ("Kinect v1 model"), outside the repository.
 const fs::path kRealRgbd = "/work/shared/data/real-rgbd";
 
+using test_util::ErrorOf;
+using test_util::ReadBytes;
 using test_util::TempDir;
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 void WriteBytes(const fs::path& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -75,15 +70,6 @@ void WriteWithOiio(const fs::path& path, int width, int height, int channels, OI
   ASSERT_TRUE(out->open(path.string(), spec));
   ASSERT_TRUE(out->write_image(type, pixels.data()));
   ASSERT_TRUE(out->close());
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
 }
 
 TEST(ImageIoTest, DepthRoundTripIsBitExactAndDeterministic) {

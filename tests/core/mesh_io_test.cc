@@ -25,20 +25,9 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 // A fresh folder under the system temp dir, removed at the end of the test.
+using test_util::ReadBytes;
 using test_util::TempDir;
-
-void WriteText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  ASSERT_TRUE(out.good());
-}
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test_util::WriteText;
 
 // A closed tetrahedron with shared vertices, one colour per face, off the origin.
 TriangleMesh Tetrahedron() {

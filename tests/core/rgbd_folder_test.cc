@@ -28,29 +28,10 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
+using test_util::ErrorOf;
+using test_util::ReadBytes;
 using test_util::TempDir;
-
-void WriteText(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  ASSERT_TRUE(out.good());
-}
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
+using test_util::WriteText;
 
 RgbdCameraInfo SmallCamera() {
   RgbdCameraInfo camera;
@@ -106,7 +87,7 @@ TEST(RgbdFolderTest, RoundTripIsBitIdentical) {
   ASSERT_TRUE(fs::is_directory(dir / "seq"));
   EXPECT_TRUE(fs::exists(dir / "seq" / "depth" / "100.000000.png"));
   EXPECT_TRUE(fs::exists(dir / "seq" / "rgb" / "100.033333.png"));
-  EXPECT_THAT(ReadText(dir / "seq" / "depth.txt"),
+  EXPECT_THAT(ReadBytes(dir / "seq" / "depth.txt"),
               HasSubstr("# timestamp filename\n100.000000 depth/100.000000.png\n"
                         "100.033333 depth/100.033333.png\n"));
 
@@ -330,7 +311,7 @@ TEST(RgbdFolderTest, ReaderErrorsNameTheFileAndLine) {
     writer.Finish();
   }
   const fs::path s = dir / "s";
-  const std::string good_depth = ReadText(s / "depth.txt");
+  const std::string good_depth = ReadBytes(s / "depth.txt");
   WriteText(s / "depth.txt", good_depth + "3.0 depth/3.000000.png extra\n");
   EXPECT_THAT(ErrorOf([&] { RgbdFolderReader r(s); }),
               HasSubstr((s / "depth.txt").string() + ":6: got 3 fields"));
@@ -338,7 +319,7 @@ TEST(RgbdFolderTest, ReaderErrorsNameTheFileAndLine) {
   EXPECT_THAT(ErrorOf([&] { RgbdFolderReader r(s); }),
               HasSubstr("depth.txt:6, timestamp: got 'three'"));
   WriteText(s / "depth.txt", good_depth + "3.0 depth/3.000000.png\n");
-  WriteText(s / "rgb.txt", ReadText(s / "rgb.txt") + "3.0 rgb/3.000000.png\n");
+  WriteText(s / "rgb.txt", ReadBytes(s / "rgb.txt") + "3.0 rgb/3.000000.png\n");
   EXPECT_THAT(ErrorOf([&] { RgbdFolderReader r(s); }),
               HasSubstr("rgb.txt:6: got 'rgb/3.000000.png', which does not exist"));
   WriteText(s / "depth.txt", good_depth);
@@ -362,7 +343,7 @@ TEST(RgbdFolderTest, ReaderChecksImageSizesAndCameraJson) {
   EXPECT_THAT(ErrorOf([&] { reader.Read(0); }),
               HasSubstr("1.000000.png: got an image of 8x8 px, expected 16x12 px"));
 
-  nlohmann::json json = nlohmann::json::parse(ReadText(s / "camera.json"));
+  nlohmann::json json = nlohmann::json::parse(ReadBytes(s / "camera.json"));
   json["depth_scal"] = 0.001;
   WriteText(s / "camera.json", json.dump());
   EXPECT_THAT(ErrorOf([&] { RgbdFolderReader r(s); }), HasSubstr("the unknown key 'depth_scal'"));

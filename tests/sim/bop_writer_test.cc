@@ -23,23 +23,9 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
+using test_util::ErrorOf;
+using test_util::ReadBytes;
 using test_util::TempDir;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
 
 TEST(BopWriterTest, JsonParsesBackToThePoses) {
   TempDir dir;
@@ -61,7 +47,7 @@ TEST(BopWriterTest, JsonParsesBackToThePoses) {
   intrinsics.cy = 239.75;
   WriteBopScene(dir / "000001", frames, intrinsics);
 
-  const auto gt = nlohmann::json::parse(ReadText(dir / "000001" / "scene_gt.json"));
+  const auto gt = nlohmann::json::parse(ReadBytes(dir / "000001" / "scene_gt.json"));
   ASSERT_EQ(gt.size(), frames.size());
   for (size_t i = 0; i < frames.size(); ++i) {
     const auto& image = gt.at(std::to_string(i));
@@ -83,13 +69,13 @@ TEST(BopWriterTest, JsonParsesBackToThePoses) {
       }
     }
   }
-  const auto camera = nlohmann::json::parse(ReadText(dir / "000001" / "scene_camera.json"));
+  const auto camera = nlohmann::json::parse(ReadBytes(dir / "000001" / "scene_camera.json"));
   ASSERT_EQ(camera.size(), frames.size());
   EXPECT_EQ(camera["11"]["cam_K"],
             nlohmann::json({525.125, 0.0, 319.5, 0.0, 525.0, 239.75, 0.0, 0.0, 1.0}));
   EXPECT_EQ(camera["0"]["depth_scale"].get<double>(), 0.2);
   // Keys in increasing image id, one image per line.
-  const std::string text = ReadText(dir / "000001" / "scene_gt.json");
+  const std::string text = ReadBytes(dir / "000001" / "scene_gt.json");
   EXPECT_LT(text.find("\"9\""), text.find("\"10\""));
   EXPECT_THAT(text, HasSubstr("\n  \"3\": [],\n"));
 }

@@ -32,23 +32,9 @@ using ::testing::HasSubstr;
 constexpr const char* kFakenectLibrary = "/usr/lib/x86_64-linux-gnu/fakenect/libfreenect.so.0.5";
 constexpr size_t kPixels = 640 * 480;
 
+using test_util::ErrorOf;
+using test_util::ReadBytes;
 using test_util::TempDir;
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
 
 std::vector<uint16_t> RandomRaw(unsigned seed) {
   std::mt19937 rng(seed);
