@@ -197,29 +197,17 @@ struct ListEntry {
 
 // A TUM list file: '#' comments, then 'timestamp filename' per line.
 std::vector<ListEntry> ReadList(const fs::path& path) {
-  const std::string text = ReadTextFile(path);
   std::vector<ListEntry> entries;
-  std::istringstream lines(text);
-  std::string line;
-  int line_number = 0;
-  while (std::getline(lines, line)) {
-    ++line_number;
-    const std::string_view content = Trim(line);
-    if (content.empty() || content.front() == '#') continue;
-    const std::string where = path.string() + ":" + std::to_string(line_number);
-    const auto fields = SplitFields(content, " \t");
-    if (fields.size() != 2) {
-      ThrowBadValue(where,
-                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
-                    "2 fields: timestamp filename");
-    }
-    double timestamp = 0;
-    if (!ParseDouble(fields[0], &timestamp) || !std::isfinite(timestamp)) {
-      ThrowBadValue(where + ", timestamp", "'" + std::string(fields[0]) + "'",
-                    "a finite number of seconds");
-    }
-    entries.push_back({timestamp, fs::path(std::string(fields[1])), line_number});
-  }
+  ForEachDataRow(
+      path, 2, "2 fields: timestamp filename",
+      [&](const std::string& where, const std::vector<std::string_view>& fields, int line_number) {
+        double timestamp = 0;
+        if (!ParseDouble(fields[0], &timestamp) || !std::isfinite(timestamp)) {
+          ThrowBadValue(where + ", timestamp", "'" + std::string(fields[0]) + "'",
+                        "a finite number of seconds");
+        }
+        entries.push_back({timestamp, fs::path(std::string(fields[1])), line_number});
+      });
   if (entries.empty()) {
     ThrowBadValue(path.string(), "no entries", "at least one line 'timestamp filename'");
   }

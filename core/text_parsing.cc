@@ -75,4 +75,27 @@ std::string_view Trim(std::string_view text) {
   return text.substr(start, end - start + 1);
 }
 
+void ForEachDataRow(
+    const std::filesystem::path& path, std::size_t field_count, const std::string& layout,
+    const std::function<void(const std::string& where, const std::vector<std::string_view>& fields,
+                             int line)>& row) {
+  const std::string text = ReadTextFile(path);
+  std::istringstream lines(text);
+  std::string line;
+  int line_number = 0;
+  while (std::getline(lines, line)) {
+    ++line_number;
+    const std::string_view content = Trim(line);
+    if (content.empty() || content.front() == '#') continue;
+    const std::string where = path.string() + ":" + std::to_string(line_number);
+    const auto fields = SplitFields(content, " \t");
+    if (fields.size() != field_count) {
+      ThrowBadValue(where,
+                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
+                    layout);
+    }
+    row(where, fields, line_number);
+  }
+}
+
 }  // namespace mmh

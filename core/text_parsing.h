@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,5 +23,14 @@ bool ParseDouble(std::string_view text, double* value);
 
 // Removes leading and trailing white space (including '\r').
 std::string_view Trim(std::string_view text);
+
+// The data rows of a whitespace-separated text file (TUM trajectories and lists): calls
+// row(where, fields, line) for every line that is not blank or a '#' comment, where = "path:line".
+// A row with another number of fields than `field_count` is an InputError naming the file and
+// line, the row and `layout` (e.g. "8 fields: timestamp tx ty tz qx qy qz qw").
+void ForEachDataRow(
+    const std::filesystem::path& path, std::size_t field_count, const std::string& layout,
+    const std::function<void(const std::string& where, const std::vector<std::string_view>& fields,
+                             int line)>& row);
 
 }  // namespace mmh

@@ -10,50 +10,38 @@
 namespace mmh {
 
 Trajectory ReadTum(const std::filesystem::path& path) {
-  const std::string text = ReadTextFile(path);
   Trajectory trajectory;
-  std::size_t line_number = 0;
-  std::istringstream lines(text);
-  std::string line;
-  while (std::getline(lines, line)) {
-    ++line_number;
-    const std::string_view content = Trim(line);
-    if (content.empty() || content.front() == '#') continue;
-    const std::string where = path.string() + ":" + std::to_string(line_number);
-    const auto fields = SplitFields(content, " \t");
-    if (fields.size() != 8) {
-      ThrowBadValue(where,
-                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
-                    "8 fields: timestamp tx ty tz qx qy qz qw");
-    }
-    double v[8];
-    static const char* kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
-    for (int i = 0; i < 8; ++i) {
-      if (!ParseDouble(fields[i], &v[i]) || !std::isfinite(v[i])) {
-        ThrowBadValue(where + ", field " + kNames[i], "'" + std::string(fields[i]) + "'",
-                      "a finite number");
-      }
-    }
-    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    const double norm = q.norm();
-    if (norm < 1e-12) {
-      ThrowBadValue(where + ", quaternion", "a zero quaternion", "a unit quaternion");
-    }
-    if (std::abs(norm - 1.0) > 1e-2) {
-      ThrowBadValue(where + ", quaternion norm", FormatNumber(norm),
-                    "a unit quaternion (norm within 1 \u00b1 0.01)");
-    }
-    // Only when needed: normalising a quaternion that is already unit to the last bits would change
-    // those bits, and reading then writing a file must give it back unchanged.
-    if (std::abs(norm - 1.0) > 1e-12) q.normalize();
-    if (!trajectory.timestamps.empty() && !(v[0] > trajectory.timestamps.back())) {
-      ThrowBadValue(
-          where + ", timestamp", FormatNumber(v[0]),
-          "greater than the previous timestamp " + FormatNumber(trajectory.timestamps.back()));
-    }
-    trajectory.timestamps.push_back(v[0]);
-    trajectory.poses.emplace_back(q, Eigen::Vector3d(v[1], v[2], v[3]));
-  }
+  ForEachDataRow(
+      path, 8, "8 fields: timestamp tx ty tz qx qy qz qw",
+      [&](const std::string& where, const std::vector<std::string_view>& fields, int) {
+        double v[8];
+        static const char* kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+        for (int i = 0; i < 8; ++i) {
+          if (!ParseDouble(fields[i], &v[i]) || !std::isfinite(v[i])) {
+            ThrowBadValue(where + ", field " + kNames[i], "'" + std::string(fields[i]) + "'",
+                          "a finite number");
+          }
+        }
+        Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+        const double norm = q.norm();
+        if (norm < 1e-12) {
+          ThrowBadValue(where + ", quaternion", "a zero quaternion", "a unit quaternion");
+        }
+        if (std::abs(norm - 1.0) > 1e-2) {
+          ThrowBadValue(where + ", quaternion norm", FormatNumber(norm),
+                        "a unit quaternion (norm within 1 \u00b1 0.01)");
+        }
+        // Only when needed: normalising a quaternion that is already unit to the last bits would
+        // change those bits, and reading then writing a file must give it back unchanged.
+        if (std::abs(norm - 1.0) > 1e-12) q.normalize();
+        if (!trajectory.timestamps.empty() && !(v[0] > trajectory.timestamps.back())) {
+          ThrowBadValue(
+              where + ", timestamp", FormatNumber(v[0]),
+              "greater than the previous timestamp " + FormatNumber(trajectory.timestamps.back()));
+        }
+        trajectory.timestamps.push_back(v[0]);
+        trajectory.poses.emplace_back(q, Eigen::Vector3d(v[1], v[2], v[3]));
+      });
   if (trajectory.empty()) {
     ThrowBadValue(path.string(), "no poses", "at least one line 'timestamp tx ty tz qx qy qz qw'");
   }
