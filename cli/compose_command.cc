@@ -8,6 +8,7 @@
 #include <memory>
 #include <sstream>
 
+#include "cli/command_registry.h"
 #include "cli/provenance.h"
 #include "core/annotation.h"
 #include "core/atomic_file.h"
@@ -157,5 +158,7 @@ void AddComposeCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
   cmd->callback([args, argv] { RunCompose(*args, argv); });
 }
+
+MMH_REGISTER_COMMAND(10, AddComposeCommand);
 
 }  // namespace mmh::cli

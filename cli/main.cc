@@ -6,8 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/compose_command.h"
-#include "cli/render_command.h"
+#include "cli/command_registry.h"
 #include "core/error.h"
 
 int main(int argc, char** argv) {
@@ -15,9 +14,9 @@ int main(int argc, char** argv) {
   CLI::App app{"mmh: the MotionMontage research harness"};
   app.require_subcommand(1);
   app.set_version_flag("--version", MMH_VERSION);
-  mmh::cli::AddComposeCommand(app, args);
-  mmh::cli::AddRenderCommand(app, args);
-  mmh::cli::AddSensorCheckCommand(app, args);
+  for (const mmh::cli::RegisteredCommand& command : mmh::cli::RegisteredCommands()) {
+    command.add(app, args);
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

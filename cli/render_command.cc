@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 
+#include "cli/command_registry.h"
 #include "cli/compose_command.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
@@ -168,5 +169,8 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
       ->check(CLI::NonNegativeNumber);
   cmd->callback([args, argv] { RunSensorCheck(*args, argv); });
 }
+
+MMH_REGISTER_COMMAND(20, AddRenderCommand);
+MMH_REGISTER_COMMAND(90, AddSensorCheckCommand);
 
 }  // namespace mmh::cli
