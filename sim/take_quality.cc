@@ -1,0 +1,220 @@
+#include "sim/take_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/error.h"
+
+namespace mmh::sim {
+namespace {
+
+double WrapAngle(double a) { return std::remainder(a, 2 * std::numbers::pi); }
+
+double LogRatioScore(double measured, double target, double log_sd) {
+  if (target <= 0.0) return 1.0;
+  const double r = std::log(std::max(measured, 1e-4) / target);
+  return std::exp(-r * r / (2 * log_sd * log_sd));
+}
+
+// Intensity of beat `beat` at progress u (linear between its start and end values).
+double IntensityAt(const Beat& beat, double u) {
+  return beat.intensity + (beat.intensity_end - beat.intensity) * std::clamp(u, 0.0, 1.0);
+}
+
+}  // namespace
+
+void QualityOptions::Validate(const std::string& prefix) const {
+  RequirePositive(window, prefix + ".window", "s");
+  RequirePositive(path_sigma, prefix + ".path_sigma", "m");
+  RequireProbability(off_area_factor, prefix + ".off_area_factor");
+  RequirePositive(play_area_width, prefix + ".play_area_width", "m");
+  RequirePositive(play_area_depth, prefix + ".play_area_depth", "m");
+  RequirePositive(steadiness_scale, prefix + ".steadiness_scale", "m");
+  RequireNonNegative(steadiness_weight, prefix + ".steadiness_weight");
+  RequirePositive(feature_log_sd, prefix + ".feature_log_sd");
+  RequirePositive(speed_log_sd, prefix + ".speed_log_sd");
+  RequirePositive(stillness_speed, prefix + ".stillness_speed", "m/s");
+  RequirePositive(hit_sigma, prefix + ".hit_sigma", "m");
+  RequireProbability(kind_mismatch, prefix + ".kind_mismatch");
+  RequireProbability(expression_floor, prefix + ".expression_floor");
+  RequireProbability(motion_floor, prefix + ".motion_floor");
+}
+
+double TiltFromUpright(const Eigen::Quaterniond& table_R_proxy) {
+  const double up = (table_R_proxy * Eigen::Vector3d::UnitZ()).z();
+  return std::acos(std::clamp(up, -1.0, 1.0));
+}
+
+double FacingHeading(const Eigen::Quaterniond& table_R_proxy) {
+  // The x axis stays horizontal while the figure tilts forwards or backwards (about x), so it
+  // gives the heading even for a figure lying on its back; the front (−y) is x turned by −90°.
+  const Eigen::Vector3d x_axis = table_R_proxy * Eigen::Vector3d::UnitX();
+  return std::atan2(x_axis.y(), x_axis.x()) - std::numbers::pi / 2;
+}
+
+QualityTrace ComputeTakeQuality(const QualityInputs& in, const QualityOptions& options) {
+  const StoryObject& object = *in.object;
+  const auto& poses = in.table_T_proxy->poses;
+  const int n = static_cast<int>(poses.size());
+  QualityTrace trace;
+  for (auto* v : {&trace.quality, &trace.fidelity, &trace.path, &trace.steadiness,
+                  &trace.expression, &trace.motion}) {
+    v->assign(n, 0.0);
+  }
+  if (n == 0) return trace;
+  const double dt = 1.0 / in.frame_rate;
+  const int w = std::max(1, static_cast<int>(std::lround(options.window * in.frame_rate)));
+
+  std::vector<Eigen::Vector3d> position(n);
+  std::vector<double> tilt(n), heading(n);
+  for (int i = 0; i < n; ++i) {
+    position[i] = poses[i].translation;
+    tilt[i] = TiltFromUpright(poses[i].rotation);
+    heading[i] = FacingHeading(poses[i].rotation);
+  }
+  // Unwrapped heading, so that ranges over a window are meaningful.
+  for (int i = 1; i < n; ++i) heading[i] = heading[i - 1] + WrapAngle(heading[i] - heading[i - 1]);
+
+  // Tremor: residual of the horizontal position from its centred 7-frame mean (the vertical
+  // carries the steps' bounce, which is wanted).
+  std::vector<double> residual2(n, 0.0);
+  for (int i = 0; i < n; ++i) {
+    const int a = std::max(0, i - 3), b = std::min(n - 1, i + 3);
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (int k = a; k <= b; ++k) mean += position[k].head<2>();
+    mean /= (b - a + 1);
+    residual2[i] = (position[i].head<2>() - mean).squaredNorm();
+  }
+
+  for (const PerformedSegment& segment : in.segments) {
+    const Beat& beat = object.beats[segment.script_beat];
+    const BeatStyleTarget target = ScriptTarget(beat.kind);
+    const std::vector<Eigen::Vector2d> polyline = object.BeatPolyline(segment.script_beat);
+    const double length = PolylineLength(polyline);
+    const double nominal_speed = length / object.BeatDuration(segment.script_beat);
+    const int first = segment.first_frame, last = segment.last_frame;
+
+    // Features decided at the beat's end (a fall either went down or not).
+    double end_score = 1.0;
+    if (beat.kind == BeatKind::kFall || beat.kind == BeatKind::kSlip) {
+      double reached = 0.0;
+      for (int k = first; k <= last; ++k) reached = std::max(reached, tilt[k]);
+      end_score = LogRatioScore(reached, target.tilt, options.feature_log_sd);
+    } else if (beat.kind == BeatKind::kGetUp) {
+      end_score = std::exp(-std::pow(tilt[last] / 0.2, 2));
+    } else if (beat.kind == BeatKind::kTurn) {
+      // Facing the next travelling beat's direction at the end.
+      for (int next = segment.script_beat + 1; next < static_cast<int>(object.beats.size());
+           ++next) {
+        if (!Travels(object.beats[next].kind)) continue;
+        const std::vector<Eigen::Vector2d> p = object.BeatPolyline(next);
+        Eigen::Vector2d tangent;
+        PolylinePoint(p, 0.0, &tangent);
+        const double wanted = std::atan2(tangent.y(), tangent.x());
+        end_score = 0.5 * (1 + std::cos(heading[last] - wanted));
+        break;
+      }
+    } else if (beat.kind == BeatKind::kHit) {
+      const auto& hit = in.hit_targets.size() > static_cast<std::size_t>(segment.script_beat)
+                            ? in.hit_targets[segment.script_beat]
+                            : std::nullopt;
+      if (hit) {
+        double best = std::numeric_limits<double>::infinity();
+        for (int k = std::max(first, last - w); k <= last; ++k) {
+          best = std::min(best, (position[k] - *hit).norm());
+        }
+        end_score = std::exp(-best * best / (2 * options.hit_sigma * options.hit_sigma));
+      }
+    }
+
+    for (int i = first; i <= last; ++i) {
+      const int a = std::max(first, i - w), b = std::min(last, i + w);
+      const double u = in.script_progress[i];
+      const double intensity = IntensityAt(beat, u);
+
+      trace.fidelity[i] = segment.performed_kind == beat.kind ? 1.0 : options.kind_mismatch;
+
+      const Eigen::Vector2d xy = position[i].head<2>();
+      const double d = DistanceToPolyline(polyline, xy);
+      double path = std::exp(-d * d / (2 * options.path_sigma * options.path_sigma));
+      if (std::abs(xy.x()) > 0.5 * options.play_area_width ||
+          std::abs(xy.y()) > 0.5 * options.play_area_depth) {
+        path *= options.off_area_factor;
+      }
+      trace.path[i] = path;
+
+      double r2 = 0.0;
+      for (int k = a; k <= b; ++k) r2 += residual2[k];
+      const double rms = std::sqrt(r2 / (b - a + 1));
+      trace.steadiness[i] = std::exp(-std::pow(rms / options.steadiness_scale, 2));
+
+      // Expression: the beat's characteristic feature over the window.
+      double expression = 1.0;
+      double z_min = position[a].z(), z_max = position[a].z(), tilt_max = 0.0;
+      double h_min = heading[a], h_max = heading[a];
+      for (int k = a; k <= b; ++k) {
+        z_min = std::min(z_min, position[k].z());
+        z_max = std::max(z_max, position[k].z());
+        tilt_max = std::max(tilt_max, tilt[k]);
+        h_min = std::min(h_min, heading[k]);
+        h_max = std::max(h_max, heading[k]);
+      }
+      switch (beat.kind) {
+        case BeatKind::kWalk:
+        case BeatKind::kMarch:
+        case BeatKind::kStroll:
+        case BeatKind::kLimp:
+        case BeatKind::kJump:
+          expression =
+              LogRatioScore(z_max - z_min, target.bounce * intensity, options.feature_log_sd);
+          if (target.sway > 0) {
+            expression = std::sqrt(expression * LogRatioScore(tilt_max, target.sway * intensity,
+                                                              options.feature_log_sd));
+          }
+          break;
+        case BeatKind::kLookAround:
+          expression = LogRatioScore(0.5 * (h_max - h_min), target.yaw_swing * intensity,
+                                     options.feature_log_sd);
+          break;
+        case BeatKind::kLie:
+          expression = LogRatioScore(tilt[i], target.tilt, options.feature_log_sd);
+          break;
+        case BeatKind::kFall:
+        case BeatKind::kSlip:
+        case BeatKind::kGetUp:
+        case BeatKind::kTurn:
+        case BeatKind::kHit:
+          expression = end_score;
+          break;
+        case BeatKind::kStand:
+          break;
+      }
+      trace.expression[i] = expression;
+
+      // Motion: speed and direction of travel, or stillness.
+      const int c0 = std::max(a, i - 3), c1 = std::min(b, i + 3);
+      Eigen::Vector2d velocity = Eigen::Vector2d::Zero();
+      if (c1 > c0) velocity = (position[c1] - position[c0]).head<2>() / ((c1 - c0) * dt);
+      const double speed = velocity.norm();
+      double motion = 1.0;
+      if (Travels(beat.kind)) {
+        Eigen::Vector2d tangent;
+        PolylinePoint(polyline, length * u, &tangent);
+        const double direction = speed > 1e-3 ? 0.5 * (1 + velocity.dot(tangent) / speed) : 0.5;
+        motion = LogRatioScore(speed, nominal_speed, options.speed_log_sd) * direction;
+      } else if (beat.kind != BeatKind::kTurn && beat.kind != BeatKind::kLookAround) {
+        motion = std::exp(-std::pow(speed / options.stillness_speed, 2));
+      }
+      trace.motion[i] = motion;
+
+      trace.quality[i] = trace.fidelity[i] * trace.path[i] *
+                         std::pow(trace.steadiness[i], options.steadiness_weight) *
+                         (options.expression_floor + (1 - options.expression_floor) * expression) *
+                         (options.motion_floor + (1 - options.motion_floor) * motion);
+    }
+  }
+  return trace;
+}
+
+}  // namespace mmh::sim
