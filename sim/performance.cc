@@ -159,7 +159,9 @@ Plan PlanTake(const StoryObject& object, const AnimatorProfile& animator, int ta
     const double length = random.Exponential(options.hesitation_seconds);
     const double fall = random.Uniform(0.25, 0.6);
     const double off_size = random.Uniform(0.04, 0.07);
-    if (u_hesitate < options.hesitation_rate * flaw && seg.duration > 1.5) {
+    // A hesitation stops the figure on its way for a moment.
+    if (Travels(seg.kind) && seg.kind != BeatKind::kHit &&
+        u_hesitate < options.hesitation_rate * flaw && seg.duration > 1.5) {
       seg.hesitation_at = at;
       seg.hesitation_length = std::clamp(length, 0.4, 3.0);
       seg.flaws.push_back(FlawKind::kHesitation);
@@ -414,6 +416,8 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
     xyz.x() += plan.wander_amplitude * plan.wander[0](t);
     xyz.y() += plan.wander_amplitude * plan.wander[1](t);
     for (int a = 0; a < 3; ++a) xyz[a] += plan.tremor_amplitude * plan.tremor[a](t);
+    // The table stops the figure: the tremor can lift it, never push it in.
+    xyz.z() = std::max(xyz.z(), kHalfDepth * std::abs(std::sin(pitch)));
     const double angle = plan.tremor_amplitude * options.tremor_angle;
     const Eigen::Quaterniond tremor =
         AxisAngle(angle * plan.tremor[3](t), Eigen::Vector3d::UnitX()) *
@@ -462,6 +466,19 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
   return out;
 }
 
+// The performed segments (maximal runs of one script beat and one action) of a take.
+std::vector<PerformedSegment> SegmentsOf(const PerformedTake& take) {
+  std::vector<PerformedSegment> segments;
+  for (int i = 0; i < take.frames(); ++i) {
+    if (segments.empty() || segments.back().script_beat != take.script_beat[i] ||
+        segments.back().performed_kind != take.performed_kind[i]) {
+      segments.push_back({take.script_beat[i], take.performed_kind[i], i, i});
+    }
+    segments.back().last_frame = i;
+  }
+  return segments;
+}
+
 PerformedTake Finish(const StoryObject& object, int object_index, int take, const Plan& plan,
                      Generated generated, const PerformanceOptions& options,
                      std::vector<std::optional<Eigen::Vector3d>> hit_targets) {
@@ -469,18 +486,15 @@ PerformedTake Finish(const StoryObject& object, int object_index, int take, cons
   result.take = take;
   result.object = object_index;
   result.skill = plan.skill;
-  QualityInputs inputs;
-  inputs.object = &object;
-  inputs.table_T_proxy = &generated.table_T_proxy;
-  inputs.frame_rate = options.frame_rate;
-  inputs.segments = generated.segments;
-  inputs.script_progress = generated.progress;
-  inputs.hit_targets = std::move(hit_targets);
-  result.quality = ComputeTakeQuality(inputs, options.quality);
   result.table_T_proxy = std::move(generated.table_T_proxy);
   result.script_beat = std::move(generated.script_beat);
   result.performed_kind = std::move(generated.kind);
+  result.script_progress = std::move(generated.progress);
+  result.hit_targets = std::move(hit_targets);
+  result.hit_targets.resize(object.beats.size());
   result.flaws = std::move(generated.flaws);
+  result.quality =
+      MeasureQuality(object, result, result.table_T_proxy, options.quality, options.frame_rate);
   return result;
 }
 
@@ -536,6 +550,24 @@ void PerformanceOptions::Validate(const std::string& prefix) const {
   RequirePositive(hesitation_seconds, prefix + ".hesitation_seconds", "s");
   RequirePositive(heading_time_constant, prefix + ".heading_time_constant", "s");
   quality.Validate(prefix + ".quality");
+}
+
+QualityTrace MeasureQuality(const StoryObject& object, const PerformedTake& take,
+                            const Trajectory& motion, const QualityOptions& options,
+                            double frame_rate) {
+  if (motion.poses.size() != take.table_T_proxy.poses.size()) {
+    ThrowBadValue("motion measured against take " + std::to_string(take.take),
+                  std::to_string(motion.poses.size()) + " poses",
+                  "one per frame of the take (" + std::to_string(take.frames()) + ")");
+  }
+  QualityInputs inputs;
+  inputs.object = &object;
+  inputs.table_T_proxy = &motion;
+  inputs.frame_rate = frame_rate;
+  inputs.segments = SegmentsOf(take);
+  inputs.script_progress = take.script_progress;
+  inputs.hit_targets = take.hit_targets;
+  return ComputeTakeQuality(inputs, options);
 }
 
 double PerformedTake::MeanQuality() const {

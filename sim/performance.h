@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -111,13 +112,21 @@ struct PerformedTake {
   Trajectory table_T_proxy;              // #frames poses, timestamps i / frame_rate
   std::vector<int> script_beat;          // #frames: the script beat being performed
   std::vector<BeatKind> performed_kind;  // #frames: what the animator actually did
-  QualityTrace quality;                  // #frames latent quality and its factors
+  std::vector<double> script_progress;   // #frames: progress in the script beat, 0..1
+  std::vector<std::optional<Eigen::Vector3d>> hit_targets;  // per script beat: where a hit lands
+  QualityTrace quality;  // #frames latent quality and its factors
   std::vector<Flaw> flaws;
   std::vector<int> markers;  // layered takes: spatial marker frames (montage timeline)
 
   int frames() const { return static_cast<int>(table_T_proxy.poses.size()); }
   double MeanQuality() const;
 };
+
+// The latent quality of `motion` (#frames table_T_proxy, e.g. a tracked or edited version of the
+// take) performed as `take` was (same beats, progress and hit targets).
+QualityTrace MeasureQuality(const StoryObject& object, const PerformedTake& take,
+                            const Trajectory& motion, const QualityOptions& options,
+                            double frame_rate);
 
 // Performs take `take` of `story.objects[object]`. Deterministic in (seed, take, object).
 // Throws InputError for a layered object (one with hit beats): use PerformLayeredTake.
