@@ -86,6 +86,9 @@ AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorP
 
   // Judgement: taste through a soft saturation, plus a slowly drifting opinion (AR(1)).
   session.judgement.resize(n);
+  // What the hand aims at: beyond an end of the box when the opinion is beyond it (the block is
+  // pushed against the end stop).
+  std::vector<double> aim(n);
   const double rho = std::exp(-dt / options.opinion_time_constant);
   double opinion = random.Normal();
   for (int i = 0; i < n; ++i) {
@@ -94,6 +97,7 @@ AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorP
         kSliderLimit *
             std::tanh(profile.taste_gain * (quality[i] - profile.taste_threshold) / kSliderLimit) +
         profile.opinion_noise * opinion;
+    aim[i] = j;
     session.judgement[i] = std::clamp(j, -kSliderLimit, kSliderLimit);
   }
 
@@ -143,7 +147,7 @@ AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorP
   for (int i = 0; i < n; ++i) {
     if (!lapsed[i]) {
       const double seen = i - session.delay[i] * fps;  // the frame whose judgement arrives now
-      target = seen < 0 ? options.start_value : Sample(session.judgement, seen);
+      target = seen < 0 ? options.start_value : Sample(aim, seen);
     }
     for (int s = 0; s < options.substeps; ++s) {
       // Semi-implicit Euler: stable for ω·h << 1 (h = 4 ms at the defaults).
