@@ -1,0 +1,74 @@
+// A simulated take for the tracker's tests and benchmark: the renderer's table-top scene with the
+// Soldier proxy, the hand and the slider block, rendered by the Kinect model in memory, with the
+// ground truth beside each frame. Only tests and benchmarks use sim/; track/ never does.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <utility>
+
+#include "core/rgbd_frame.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+#include "sim/kinect_sensor.h"
+#include "sim/render_session.h"
+#include "track/setup.h"
+
+namespace mmh::track::test_take {
+
+class SimTake {
+ public:
+  // table_T_proxy(t) and slider(t) drive the proxy and the block; empty: the demo walk and sweep
+  // of config.motion.
+  explicit SimTake(sim::RenderConfig config = {}, std::function<Rigid3(double)> table_T_proxy = {},
+                   std::function<double(double)> slider = {})
+      : config_(std::move(config)),
+        table_T_proxy_(std::move(table_T_proxy)),
+        slider_(std::move(slider)) {
+    model_ = sim::LoadProxyModel(config_.render.proxy, config_.render.proxy_scale);
+    scene_ = std::make_unique<sim::TableTopScene>(config_, model_);
+    sensor_ = std::make_unique<sim::KinectSensor>(config_.sensor, &scene_->scene(),
+                                                  scene_->table_T_camera());
+    depth_T_table_ = sensor_->world_T_depth_camera().Inverse();
+  }
+
+  // Renders frame i; the true camera_T_proxy and slider value when asked.
+  RgbdFrame Render(int i, Rigid3* camera_T_proxy = nullptr, double* slider_value = nullptr) {
+    const double t = i / config_.sensor.frame_rate;
+    const Rigid3 table_T_proxy = table_T_proxy_ ? table_T_proxy_(t) : config_.motion.TableTProxy(t);
+    const double slider = slider_ ? slider_(t) : config_.motion.SliderValue(t);
+    scene_->SetFrame(table_T_proxy, slider);
+    if (camera_T_proxy) *camera_T_proxy = depth_T_table_ * table_T_proxy;
+    if (slider_value) *slider_value = slider;
+    return sensor_->Render(i);
+  }
+
+  // The setup calibration a user would mark once (as scene.json holds it).
+  TrackSetup Setup() const {
+    TrackSetup setup;
+    setup.camera_T_table = depth_T_table_;
+    setup.play_area_width = config_.scene.play_area_width;
+    setup.play_area_depth = config_.scene.play_area_depth;
+    setup.like_box_center_x = config_.scene.like_box_center_x;
+    setup.like_box_center_y = config_.scene.like_box_center_y;
+    setup.like_box_length = config_.scene.like_box_length;
+    setup.like_box_width = config_.scene.like_box_width;
+    setup.slider_block_size = sim::kSliderBlockSize;
+    return setup;
+  }
+
+  const TriangleMesh& model() const { return model_; }
+  const Rigid3& depth_T_table() const { return depth_T_table_; }
+  const sim::RenderConfig& config() const { return config_; }
+
+ private:
+  sim::RenderConfig config_;
+  std::function<Rigid3(double)> table_T_proxy_;
+  std::function<double(double)> slider_;
+  TriangleMesh model_;
+  std::unique_ptr<sim::TableTopScene> scene_;
+  std::unique_ptr<sim::KinectSensor> sensor_;
+  Rigid3 depth_T_table_;
+};
+
+}  // namespace mmh::track::test_take

@@ -1,0 +1,138 @@
+#include "track/point_to_plane_icp.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "core/error.h"
+
+namespace mmh::track {
+
+void IcpOptions::Validate(const std::string& prefix) const {
+  if (max_iterations < 1 || max_iterations > 1000) {
+    ThrowBadValue(prefix + ".max_iterations", std::to_string(max_iterations),
+                  "an integer in [1, 1000]");
+  }
+  RequirePositive(start_distance, prefix + ".start_distance", "m");
+  RequirePositive(end_distance, prefix + ".end_distance", "m");
+  if (end_distance > start_distance) {
+    ThrowBadValue(prefix + ".end_distance", FormatNumber(end_distance),
+                  "at most start_distance = " + FormatNumber(start_distance) + " m");
+  }
+  if (shrink_iterations < 0) {
+    ThrowBadValue(prefix + ".shrink_iterations", std::to_string(shrink_iterations), ">= 0");
+  }
+  RequirePositive(huber, prefix + ".huber", "m");
+  RequireNonNegative(min_rotation, prefix + ".min_rotation", "rad");
+  RequireNonNegative(min_translation, prefix + ".min_translation", "m");
+  RequirePositive(inlier_distance, prefix + ".inlier_distance", "m");
+}
+
+namespace {
+
+// Rejection distance at iteration k.
+float DistanceAt(const IcpOptions& o, int k) {
+  if (k >= o.shrink_iterations || o.shrink_iterations == 0)
+    return static_cast<float>(o.end_distance);
+  const double ratio = o.end_distance / o.start_distance;
+  return static_cast<float>(o.start_distance *
+                            std::pow(ratio, static_cast<double>(k) / o.shrink_iterations));
+}
+
+}  // namespace
+
+IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vector3f> points,
+                            size_t scored, double extra_distance, const Rigid3& proxy_T_camera,
+                            const IcpOptions& options) {
+  IcpResult result;
+  Eigen::Matrix3d rotation = proxy_T_camera.rotation.normalized().toRotationMatrix();
+  Eigen::Vector3d translation = proxy_T_camera.translation;
+  const auto& model_points = model.points();
+  const auto& model_normals = model.normals();
+  const float huber = static_cast<float>(options.huber);
+  const float extra = static_cast<float>(extra_distance);
+  scored = std::min(scored, points.size());
+  for (int k = 0; k < options.max_iterations; ++k) {
+    const float limit = DistanceAt(options, k);
+    const Eigen::Matrix3f r = rotation.cast<float>();
+    const Eigen::Vector3f t = translation.cast<float>();
+    // Normal equations J^T W J xi = -J^T W r with J = [s x n, n] (xi = rotation, translation).
+    Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
+    // Accumulate in float blocks of 256 points to keep the sums exact enough and fast.
+    Eigen::Matrix<float, 6, 6> hf = Eigen::Matrix<float, 6, 6>::Zero();
+    Eigen::Matrix<float, 6, 1> gf = Eigen::Matrix<float, 6, 1>::Zero();
+    int used = 0, block = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3f rp = r * points[i];
+      const Eigen::Vector3f s = rp + t;
+      const int c = model.Closest(s);
+      if (c < 0) continue;
+      const Eigen::Vector3f& n = model_normals[c];
+      if (n.dot(rp) >= 0) continue;  // the model surface faces away from the camera
+      const Eigen::Vector3f d = s - model_points[c];
+      const float max_distance = i < scored ? limit : std::min(limit, extra);
+      if (d.squaredNorm() > max_distance * max_distance) continue;
+      const float residual = n.dot(d);
+      const float a = std::abs(residual);
+      const float w = a <= huber ? 1.0f : huber / a;
+      Eigen::Matrix<float, 6, 1> j;
+      j.head<3>() = s.cross(n);
+      j.tail<3>() = n;
+      hf.noalias() += (w * j) * j.transpose();
+      gf.noalias() += (w * residual) * j;
+      ++used;
+      if (++block == 256) {
+        h += hf.cast<double>();
+        g += gf.cast<double>();
+        hf.setZero();
+        gf.setZero();
+        block = 0;
+      }
+    }
+    h += hf.cast<double>();
+    g += gf.cast<double>();
+    result.iterations = k + 1;
+    if (used < 6) break;
+    // A small damping keeps a degenerate view (a single face) from a wild step.
+    h.diagonal().array() += 1e-9 * used;
+    const Eigen::Matrix<double, 6, 1> xi = -h.ldlt().solve(g);
+    if (!xi.allFinite()) break;
+    const Eigen::Vector3d omega = xi.head<3>();
+    const double angle = omega.norm();
+    const Eigen::Matrix3d step = angle > 0
+                                     ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix()
+                                     : Eigen::Matrix3d::Identity();
+    rotation = step * rotation;
+    translation = step * translation + xi.tail<3>();
+    if (k + 1 >= options.shrink_iterations && angle < options.min_rotation &&
+        xi.tail<3>().norm() < options.min_translation) {
+      break;
+    }
+  }
+  // Re-orthonormalise and score.
+  const Eigen::Quaterniond q = Eigen::Quaterniond(rotation).normalized();
+  result.proxy_T_camera = Rigid3(q, translation);
+  const Eigen::Matrix3f r = q.toRotationMatrix().cast<float>();
+  const Eigen::Vector3f t = translation.cast<float>();
+  const float inlier = static_cast<float>(options.inlier_distance);
+  double sum = 0.0;
+  for (size_t i = 0; i < scored; ++i) {
+    const Eigen::Vector3f rp = r * points[i];
+    const Eigen::Vector3f s = rp + t;
+    const int c = model.Closest(s);
+    if (c < 0) continue;
+    const Eigen::Vector3f& n = model_normals[c];
+    if (n.dot(rp) >= 0) continue;
+    const Eigen::Vector3f d = s - model_points[c];
+    if (d.squaredNorm() > inlier * inlier) continue;
+    const float residual = n.dot(d);
+    sum += static_cast<double>(residual) * residual;
+    ++result.inliers;
+  }
+  result.inlier_share = scored > 0 ? static_cast<double>(result.inliers) / scored : 0.0;
+  result.rms = result.inliers > 0 ? std::sqrt(sum / result.inliers) : 0.0;
+  return result;
+}
+
+}  // namespace mmh::track

@@ -1,0 +1,66 @@
+// Robust point-to-plane ICP of camera-frame data points against a ProxyModel (Chen and Medioni
+// 1992; Low 2004 for the linearisation): Gauss-Newton on proxy_T_camera with Huber weights,
+// correspondences from the model's closest-point grid, restricted to model surfaces that face the
+// camera, with a rejection distance that shrinks geometrically over the first iterations
+// (coarse to fine).
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <string>
+
+#include "core/rigid3.h"
+#include "track/proxy_model.h"
+
+namespace mmh::track {
+
+struct IcpOptions {
+  // Gauss-Newton iterations at most.
+  int max_iterations = 12;
+  // Correspondence rejection distance [m]: start_distance at the first iteration, shrinking by a
+  // constant factor to end_distance at shrink_iterations, end_distance after.
+  double start_distance = 0.02;
+  double end_distance = 0.006;
+  int shrink_iterations = 4;
+  // Huber threshold on the point-to-plane residual [m] (about the Kinect's axial noise at 1 m).
+  double huber = 0.003;
+  // Converged when an update rotates less than this [rad] and moves less than this [m] (after the
+  // distance has shrunk).
+  double min_rotation = 2e-4;
+  double min_translation = 1e-4;
+  // A correspondence counts as an inlier (for the result's statistics) within this distance [m].
+  double inlier_distance = 0.006;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("max_iterations", max_iterations);
+    v("start_distance", start_distance);
+    v("end_distance", end_distance);
+    v("shrink_iterations", shrink_iterations);
+    v("huber", huber);
+    v("min_rotation", min_rotation);
+    v("min_translation", min_translation);
+    v("inlier_distance", inlier_distance);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+struct IcpResult {
+  Rigid3 proxy_T_camera;
+  int iterations = 0;
+  // Over the scored points (the first `scored` of the data): those with a correspondence within
+  // inlier_distance on a camera-facing surface, their share, and their RMS point-to-plane
+  // residual [m].
+  int inliers = 0;
+  double inlier_share = 0.0;
+  double rms = 0.0;
+};
+
+// Aligns `points` (camera frame [m]) to the model from `proxy_T_camera`. The first `scored`
+// points are the ones the statistics count (the rest, e.g. skin-coloured points, only help the fit
+// where they lie within `extra_distance` of the model; pass points.size() for all).
+IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vector3f> points,
+                            size_t scored, double extra_distance, const Rigid3& proxy_T_camera,
+                            const IcpOptions& options);
+
+}  // namespace mmh::track

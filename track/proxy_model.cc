@@ -1,0 +1,118 @@
+#include "track/proxy_model.h"
+
+#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <unordered_map>
+
+#include "core/error.h"
+
+namespace mmh::track {
+
+void ProxyModelOptions::Validate(const std::string& prefix) const {
+  auto range = [&](double value, double lo, double hi, const char* name) {
+    RequireFinite(value, prefix + "." + name);
+    if (!(value >= lo && value <= hi)) {
+      ThrowBadValue(prefix + "." + name, FormatNumber(value),
+                    "a length in [" + FormatNumber(lo) + ", " + FormatNumber(hi) + "] m");
+    }
+  };
+  range(sample_spacing, 0.0002, 0.02, "sample_spacing");
+  range(grid_resolution, 0.0005, 0.02, "grid_resolution");
+  range(grid_margin, 0.005, 0.2, "grid_margin");
+}
+
+ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& options,
+                       const std::string& where)
+    : options_(options) {
+  options_.Validate("model");
+  ValidateMesh(mesh, where);
+  const Bounds3 bounds = ComputeBounds(mesh);
+  const Eigen::Vector3d size = bounds.max - bounds.min;
+  if (size.maxCoeff() > 1.0) {
+    ThrowBadValue(where, "a model " + FormatNumber(size.maxCoeff()) + " m across",
+                  "a hand-held proxy under 1 m (a model in millimetres needs a scale of 0.001)");
+  }
+  if (SurfaceArea(mesh) <= 0) ThrowBadValue(where, "a model without area", "triangles with area");
+  // Samples: per face, a deterministic R2 low-discrepancy sequence (Roberts 2018) folded into the
+  // triangle, count proportional to the area.
+  const auto face_normals = FaceNormals(mesh);
+  const double g = 1.32471795724474602596;  // plastic number
+  const double a1 = 1.0 / g, a2 = 1.0 / (g * g);
+  const double cell_area = options_.sample_spacing * options_.sample_spacing;
+  for (int f = 0; f < mesh.face_count(); ++f) {
+    const Eigen::Vector3f n = face_normals.row(f).transpose();
+    if (n.squaredNorm() == 0) continue;
+    const Eigen::Vector3f a = mesh.vertices.row(mesh.faces(f, 0)).transpose();
+    const Eigen::Vector3f b = mesh.vertices.row(mesh.faces(f, 1)).transpose();
+    const Eigen::Vector3f c = mesh.vertices.row(mesh.faces(f, 2)).transpose();
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    const int count = std::max(1, static_cast<int>(std::lround(area / cell_area)));
+    for (int i = 0; i < count; ++i) {
+      double s = std::fmod(0.5 + a1 * (i + 1), 1.0), t = std::fmod(0.5 + a2 * (i + 1), 1.0);
+      if (s + t > 1) {
+        s = 1 - s;
+        t = 1 - t;
+      }
+      points_.push_back(a + static_cast<float>(s) * (b - a) + static_cast<float>(t) * (c - a));
+      normals_.push_back(n);
+    }
+  }
+  center_ = (0.5 * (bounds.min + bounds.max)).cast<float>();
+  radius_ = static_cast<float>(0.5 * size.norm());
+  // Sparse subset: one sample per 4 mm cell and normal direction (the dominant axis and its sign,
+  // so that both sides of a thin part keep samples).
+  {
+    const float inverse_cell = 1.0f / 0.004f;
+    std::unordered_map<int64_t, int> seen;
+    for (int i = 0; i < static_cast<int>(points_.size()); ++i) {
+      const Eigen::Vector3f q = (points_[i] - bounds.min.cast<float>()) * inverse_cell;
+      int axis = 0;
+      normals_[i].cwiseAbs().maxCoeff(&axis);
+      const int direction = 2 * axis + (normals_[i][axis] > 0 ? 1 : 0);
+      const int64_t key =
+          ((static_cast<int64_t>(q.x()) * 4096 + static_cast<int64_t>(q.y())) * 4096 +
+           static_cast<int64_t>(q.z())) *
+              8 +
+          direction;
+      if (seen.emplace(key, i).second) sparse_.push_back(i);
+    }
+  }
+
+  // The grid: every cell centre's nearest sample (PCL's k-d tree, FLANN).
+  const float resolution = static_cast<float>(options_.grid_resolution);
+  inverse_resolution_ = 1.0f / resolution;
+  grid_origin_ = (bounds.min.array() - options_.grid_margin).cast<float>();
+  size_t cells = 1;
+  for (int d = 0; d < 3; ++d) {
+    dims_[d] = static_cast<int>(std::ceil((size[d] + 2 * options_.grid_margin) / resolution)) + 1;
+    cells *= dims_[d];
+  }
+  if (cells > (size_t{64} << 20)) {
+    ThrowBadValue("model.grid_resolution", FormatNumber(options_.grid_resolution),
+                  "a coarser grid: " + std::to_string(cells) + " cells exceed 64 M");
+  }
+  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  cloud->reserve(points_.size());
+  for (const auto& p : points_) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  grid_.resize(cells);
+  std::vector<int> index(1);
+  std::vector<float> distance(1);
+  size_t i = 0;
+  for (int z = 0; z < dims_[2]; ++z) {
+    for (int y = 0; y < dims_[1]; ++y) {
+      for (int x = 0; x < dims_[0]; ++x, ++i) {
+        const Eigen::Vector3f c =
+            grid_origin_ + resolution * Eigen::Vector3f(x + 0.5f, y + 0.5f, z + 0.5f);
+        tree.nearestKSearch(pcl::PointXYZ(c.x(), c.y(), c.z()), 1, index, distance);
+        grid_[i] = index[0];
+      }
+    }
+  }
+}
+
+}  // namespace mmh::track

@@ -1,0 +1,180 @@
+// The proxy tracker: per frame, segmentation (track/segmentation.h), motion prediction, robust
+// point-to-plane ICP against the proxy's model (track/point_to_plane_icp.h), verification, and a
+// global detection without any prior pose at the start and whenever tracking is lost. Each frame
+// gets a status: tracked (a verified measurement), predicted (too little of the proxy visible,
+// e.g. under the hand: the pose is extrapolated for a few frames) or lost (no pose).
+//
+// Verification (loss detection) rejects a pose when the inliers are too few or their residual too
+// large, when the model would hide surfaces the camera sees behind it (free-space violation: the
+// camera sees through where the model would be), or when the proxy is outside the play area.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+
+#include "core/rgbd_frame.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+#include "track/point_to_plane_icp.h"
+#include "track/proxy_model.h"
+#include "track/segmentation.h"
+#include "track/setup.h"
+#include "track/table_plane.h"
+
+namespace mmh::track {
+
+enum class TrackStatus { kTracked, kPredicted, kLost };
+// "tracked", "predicted", "lost".
+const char* TrackStatusName(TrackStatus status);
+
+struct DetectionOptions {
+  // Orientation hypotheses: yaw_steps yaws about the table normal for each of the model's six
+  // axis directions pointing up (or only its +z when all_faces_up is false).
+  int yaw_steps = 12;
+  bool all_faces_up = true;
+  // Each hypothesis is aligned with this many points of the largest segment for
+  // coarse_iterations; the best `candidates` are refined with all points and verified.
+  int coarse_points = 200;
+  int coarse_iterations = 10;
+  int candidates = 4;
+  // Rejection distance of the coarse alignment [m] (start, end).
+  double coarse_start_distance = 0.03;
+  double coarse_end_distance = 0.008;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("yaw_steps", yaw_steps);
+    v("all_faces_up", all_faces_up);
+    v("coarse_points", coarse_points);
+    v("coarse_iterations", coarse_iterations);
+    v("candidates", candidates);
+    v("coarse_start_distance", coarse_start_distance);
+    v("coarse_end_distance", coarse_end_distance);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+struct VerificationOptions {
+  // A frame needs this many segmented points to be measured [points]; fewer: predicted.
+  int min_points = 60;
+  // Inlier share (of the segmented points, within icp.inlier_distance) at least, and inlier RMS
+  // point-to-plane residual at most [m].
+  double min_inlier_share = 0.55;
+  double max_rms = 0.004;
+  // Free space: of the model's camera-facing samples with a depth reading, at most this share may
+  // show a depth more than free_space_margin [m] behind the model.
+  double max_free_space_violation = 0.12;
+  double free_space_margin = 0.015;
+  // The proxy's centre must lie within the play area grown by this margin [m] and below
+  // segmentation.max_height.
+  double play_area_margin = 0.06;
+  // Frames a pose may be extrapolated without a measurement before it is reported lost.
+  int max_predicted_frames = 10;
+  // Skin-coloured points help the fit only within this distance of the model [m].
+  double skin_distance = 0.004;
+  // At most this many segmented points enter the ICP (evenly subsampled) [points].
+  int max_points = 1500;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("min_points", min_points);
+    v("min_inlier_share", min_inlier_share);
+    v("max_rms", max_rms);
+    v("max_free_space_violation", max_free_space_violation);
+    v("free_space_margin", free_space_margin);
+    v("play_area_margin", play_area_margin);
+    v("max_predicted_frames", max_predicted_frames);
+    v("skin_distance", skin_distance);
+    v("max_points", max_points);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+struct ProxyTrackerOptions {
+  TablePlaneOptions table;
+  SegmentationOptions segmentation;
+  ProxyModelOptions model;
+  IcpOptions icp;
+  DetectionOptions detection;
+  VerificationOptions verification;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("table", table);
+    v("segmentation", segmentation);
+    v("model", model);
+    v("icp", icp);
+    v("detection", detection);
+    v("verification", verification);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+struct TrackFrameResult {
+  int index = 0;
+  double timestamp = 0.0;
+  TrackStatus status = TrackStatus::kLost;
+  // camera_T_proxy of the depth camera; meaningful unless lost.
+  Rigid3 camera_T_proxy;
+  // The pose came from a global detection (first frame, or recovery after a loss).
+  bool detected = false;
+  // Why the frame is predicted or lost, or what was wrong with it ("" when tracked).
+  std::string reason;
+  int points = 0;       // segmented proxy points
+  int skin_points = 0;  // skin-coloured foreground points
+  double inlier_share = 0.0;
+  double rms = 0.0;                   // [m]
+  double free_space_violation = 0.0;  // share
+  int iterations = 0;
+};
+
+class ProxyTracker {
+ public:
+  // `model` is the proxy's mesh in its own frame (InputError naming `model_name` when invalid).
+  // Options are validated (prefix "tracker").
+  ProxyTracker(const TriangleMesh& model, const std::string& model_name, const TrackSetup& setup,
+               const ProxyTrackerOptions& options);
+  ~ProxyTracker();
+
+  // Tracks one frame. Never throws for a bad frame: a frame of the wrong size, with other
+  // intrinsics than the first, without depth or without a table is lost with the reason.
+  TrackFrameResult Track(const RgbdFrame& frame);
+  // The frame could not be read (FrameSource::frame_error): lost with that reason.
+  TrackFrameResult Unreadable(const RgbdFrame& frame, const std::string& error);
+
+  // The table frame in the depth camera (from the estimated plane); nullopt before the first
+  // frame with a plane.
+  const std::optional<Rigid3>& camera_T_table() const { return camera_T_table_; }
+  const std::optional<TablePlane>& table_plane() const { return table_plane_; }
+  const ProxyModel& model() const { return *model_; }
+  const Segmentation& last_segmentation() const { return segmentation_; }
+
+ private:
+  struct Candidate;
+  bool EnsureTable(const RgbdFrame& frame, std::string* why);
+  std::optional<Candidate> Detect(const RgbdFrame& frame);
+  Candidate Verify(const RgbdFrame& frame, const IcpResult& icp) const;
+  double FreeSpaceViolation(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
+  ImageRect ProxyImage(const Rigid3& camera_T_proxy) const;
+
+  ProxyTrackerOptions options_;
+  TrackSetup setup_;
+  std::unique_ptr<ProxyModel> model_;
+  Segmenter segmenter_;
+  Segmentation segmentation_;
+  std::optional<PinholeIntrinsics> intrinsics_;
+  std::optional<TablePlane> table_plane_;
+  std::optional<Rigid3> camera_T_table_;
+  // Motion state: the last two measured poses and the frames predicted since.
+  std::optional<Rigid3> last_;
+  std::optional<Rigid3> velocity_;  // last * previous^-1 (camera frame, per frame)
+  int predicted_frames_ = 0;
+  // Scratch: the subsampled segmented points (the first scored_), then the skin points.
+  std::vector<Eigen::Vector3f> data_;
+  size_t scored_ = 0;
+};
+
+}  // namespace mmh::track

@@ -1,0 +1,232 @@
+#include "track/segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+
+namespace mmh::track {
+
+void SegmentationOptions::Validate(const std::string& prefix) const {
+  if (pixel_step < 1 || pixel_step > 16) {
+    ThrowBadValue(prefix + ".pixel_step", std::to_string(pixel_step), "an integer in [1, 16]");
+  }
+  RequireNonNegative(play_area_margin, prefix + ".play_area_margin", "m");
+  RequireNonNegative(min_height, prefix + ".min_height", "m");
+  RequirePositive(max_height, prefix + ".max_height", "m");
+  if (!(max_height > min_height)) {
+    ThrowBadValue(prefix + ".max_height", FormatNumber(max_height),
+                  "more than min_height = " + FormatNumber(min_height) + " m");
+  }
+  if (background_frames < 1 || background_frames > 60000) {
+    ThrowBadValue(prefix + ".background_frames", std::to_string(background_frames),
+                  "an integer in [1, 60000]");
+  }
+  RequirePositive(background_tolerance, prefix + ".background_tolerance", "m");
+  RequireNonNegative(background_margin, prefix + ".background_margin", "m");
+  auto byte = [&](int value, const char* name) {
+    if (value < 0 || value > 255) {
+      ThrowBadValue(prefix + "." + name, std::to_string(value), "an 8-bit value in [0, 255]");
+    }
+  };
+  byte(skin_cr_min, "skin_cr_min");
+  byte(skin_cr_max, "skin_cr_max");
+  byte(skin_cb_min, "skin_cb_min");
+  byte(skin_cb_max, "skin_cb_max");
+  if (skin_cr_min > skin_cr_max) {
+    ThrowBadValue(prefix + ".skin_cr_min", std::to_string(skin_cr_min), "<= skin_cr_max");
+  }
+  if (skin_cb_min > skin_cb_max) {
+    ThrowBadValue(prefix + ".skin_cb_min", std::to_string(skin_cb_min), "<= skin_cb_max");
+  }
+  if (min_component_pixels < 1) {
+    ThrowBadValue(prefix + ".min_component_pixels", std::to_string(min_component_pixels), ">= 1");
+  }
+}
+
+Segmenter::Segmenter(const SegmentationOptions& options, const TrackSetup& setup)
+    : options_(options), setup_(setup) {
+  options_.Validate("segmentation");
+}
+
+void Segmenter::SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& intrinsics) {
+  intrinsics_ = intrinsics;
+  table_T_camera_ = camera_T_table.Inverse();
+  // The play volume's image: the bounding box of its eight corners' projections.
+  const double hx = setup_.play_area_width / 2 + options_.play_area_margin;
+  const double hy = setup_.play_area_depth / 2 + options_.play_area_margin;
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  bool behind = false;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d table_p((c & 1) ? hx : -hx, (c & 2) ? hy : -hy,
+                                  (c & 4) ? options_.max_height : options_.min_height);
+    const Eigen::Vector3d camera_p = camera_T_table * table_p;
+    if (camera_p.z() < 0.05) {
+      behind = true;
+      break;
+    }
+    const Eigen::Vector2d uv = intrinsics.Project(camera_p);
+    u0 = std::min(u0, uv.x());
+    v0 = std::min(v0, uv.y());
+    u1 = std::max(u1, uv.x());
+    v1 = std::max(v1, uv.y());
+  }
+  if (behind) {
+    roi_ = {0, 0, intrinsics.width, intrinsics.height};
+  } else {
+    roi_.x0 = std::clamp(static_cast<int>(std::floor(u0)), 0, intrinsics.width);
+    roi_.y0 = std::clamp(static_cast<int>(std::floor(v0)), 0, intrinsics.height);
+    roi_.x1 = std::clamp(static_cast<int>(std::ceil(u1)) + 1, 0, intrinsics.width);
+    roi_.y1 = std::clamp(static_cast<int>(std::ceil(v1)) + 1, 0, intrinsics.height);
+  }
+  const int rw = roi_.x1 - roi_.x0, rh = roi_.y1 - roi_.y0;
+  table_rays_.resize(static_cast<size_t>(std::max(rw, 0)) * std::max(rh, 0));
+  const Eigen::Matrix3f rotation = table_T_camera_.rotation.toRotationMatrix().cast<float>();
+  for (int v = 0; v < rh; ++v) {
+    for (int u = 0; u < rw; ++u) {
+      const Eigen::Vector3d ray = intrinsics.BackProject(roi_.x0 + u, roi_.y0 + v, 1.0);
+      table_rays_[static_cast<size_t>(v) * rw + u] = rotation * ray.cast<float>();
+    }
+  }
+  background_.assign(table_rays_.size(), 0.0f);
+  running_.assign(table_rays_.size(), 0.0f);
+  stable_.assign(table_rays_.size(), 0);
+  has_table_ = true;
+}
+
+void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out) {
+  out->points.clear();
+  out->components.clear();
+  out->skin_points.clear();
+  out->component_sizes.clear();
+  out->foreground_pixels = out->skin_pixels = out->dropped_pixels = 0;
+  out->roi = roi_;
+  if (!has_table_ || roi_.empty()) return;
+  const int width = intrinsics_.width, height = intrinsics_.height;
+  const int rw = roi_.x1 - roi_.x0, rh = roi_.y1 - roi_.y0;
+  const int step = options_.pixel_step;
+  const int mw = (rw + step - 1) / step, mh = (rh + step - 1) / step;
+
+  // Skin, where the colour image is registered to the depth image.
+  cv::Mat skin;
+  const bool registered = frame.rgb.size() == static_cast<size_t>(3 * width * height) &&
+                          frame.color_intrinsics == frame.depth_intrinsics &&
+                          frame.color_T_depth.translation.norm() < 1e-9 &&
+                          std::abs(std::abs(frame.color_T_depth.rotation.w()) - 1) < 1e-12;
+  if (options_.skin && registered) {
+    const cv::Mat rgb(height, width, CV_8UC3, const_cast<uint8_t*>(frame.rgb.data()));
+    cv::Mat ycrcb;
+    cv::cvtColor(rgb(cv::Rect(roi_.x0, roi_.y0, rw, rh)), ycrcb, cv::COLOR_RGB2YCrCb);
+    cv::inRange(ycrcb, cv::Scalar(0, options_.skin_cr_min, options_.skin_cb_min),
+                cv::Scalar(255, options_.skin_cr_max, options_.skin_cb_max), skin);
+  }
+
+  // The play volume, before the background: mask 1 = proxy candidate, 2 = skin.
+  mask_.assign(static_cast<size_t>(mw) * mh, 0);
+  const Eigen::Vector3f origin = table_T_camera_.translation.cast<float>();
+  const float hx = static_cast<float>(setup_.play_area_width / 2 + options_.play_area_margin);
+  const float hy = static_cast<float>(setup_.play_area_depth / 2 + options_.play_area_margin);
+  const float z0 = static_cast<float>(options_.min_height);
+  const float z1 = static_cast<float>(options_.max_height);
+  const float scale = static_cast<float>(frame.depth_scale);
+  const float margin = static_cast<float>(options_.background_margin);
+  for (int my = 0; my < mh; ++my) {
+    const int v = my * step;
+    const uint16_t* row = frame.depth.data() + static_cast<size_t>(roi_.y0 + v) * width + roi_.x0;
+    for (int mx = 0; mx < mw; ++mx) {
+      const int u = mx * step;
+      const uint16_t d = row[u];
+      if (d == 0) continue;
+      const float z = d * scale;
+      const size_t i = static_cast<size_t>(v) * rw + u;
+      const Eigen::Vector3f table_p = z * table_rays_[i] + origin;
+      if (table_p.z() < z0 || table_p.z() > z1 || std::abs(table_p.x()) > hx ||
+          std::abs(table_p.y()) > hy) {
+        continue;
+      }
+      if (options_.background && background_[i] > 0 && z > background_[i] - margin) continue;
+      const bool is_skin = !skin.empty() && skin.at<uint8_t>(v, u) != 0;
+      mask_[static_cast<size_t>(my) * mw + mx] = is_skin ? 2 : 1;
+      ++out->foreground_pixels;
+    }
+  }
+  if (out->foreground_pixels == 0) return;
+
+  // Connected components; small ones are noise (flying pixels at edges, speckle).
+  const cv::Mat mask(mh, mw, CV_8U, mask_.data());
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<int> order;
+  for (int c = 1; c < count; ++c) {
+    if (stats.at<int>(c, cv::CC_STAT_AREA) >= options_.min_component_pixels) {
+      order.push_back(c);
+    } else {
+      out->dropped_pixels += stats.at<int>(c, cv::CC_STAT_AREA);
+    }
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return stats.at<int>(a, cv::CC_STAT_AREA) > stats.at<int>(b, cv::CC_STAT_AREA);
+  });
+  std::vector<int> rank(count, -1);
+  for (size_t r = 0; r < order.size(); ++r) {
+    rank[order[r]] = static_cast<int>(r);
+    out->component_sizes.push_back(stats.at<int>(order[r], cv::CC_STAT_AREA));
+  }
+  for (int my = 0; my < mh; ++my) {
+    const int v = my * step;
+    for (int mx = 0; mx < mw; ++mx) {
+      const uint8_t m = mask_[static_cast<size_t>(my) * mw + mx];
+      if (m == 0) continue;
+      const int r = rank[labels.at<int>(my, mx)];
+      if (r < 0) continue;
+      const int u = mx * step;
+      const float z = frame.depth[static_cast<size_t>(roi_.y0 + v) * width + roi_.x0 + u] * scale;
+      const Eigen::Vector3f p(
+          static_cast<float>((roi_.x0 + u - intrinsics_.cx) / intrinsics_.fx) * z,
+          static_cast<float>((roi_.y0 + v - intrinsics_.cy) / intrinsics_.fy) * z, z);
+      if (m == 2) {
+        out->skin_points.push_back(p);
+        ++out->skin_pixels;
+      } else {
+        out->points.push_back(p);
+        out->components.push_back(r);
+      }
+    }
+  }
+}
+
+void Segmenter::UpdateBackground(const RgbdFrame& frame, const ImageRect& exclude) {
+  if (!has_table_ || !options_.background) return;
+  const int width = intrinsics_.width;
+  const int rw = roi_.x1 - roi_.x0, rh = roi_.y1 - roi_.y0;
+  const float scale = static_cast<float>(frame.depth_scale);
+  const float tolerance = static_cast<float>(options_.background_tolerance);
+  const float margin = static_cast<float>(options_.background_margin);
+  const int step = options_.pixel_step;
+  for (int v = 0; v < rh; v += step) {
+    const int y = roi_.y0 + v;
+    const bool row_excluded = y >= exclude.y0 && y < exclude.y1;
+    for (int u = 0; u < rw; u += step) {
+      const int x = roi_.x0 + u;
+      if (row_excluded && x >= exclude.x0 && x < exclude.x1) continue;
+      const uint16_t d = frame.depth[static_cast<size_t>(y) * width + x];
+      if (d == 0) continue;
+      const float z = d * scale;
+      const size_t i = static_cast<size_t>(v) * rw + u;
+      if (background_[i] > 0 && z > background_[i] + margin) background_[i] = 0;  // uncovered
+      if (stable_[i] > 0 && std::abs(z - running_[i]) <= tolerance) {
+        if (stable_[i] < 65535) ++stable_[i];
+        running_[i] += (z - running_[i]) / std::min<float>(stable_[i], 32.0f);
+        if (stable_[i] >= options_.background_frames) background_[i] = running_[i];
+      } else {
+        running_[i] = z;
+        stable_[i] = 1;
+      }
+    }
+  }
+}
+
+}  // namespace mmh::track

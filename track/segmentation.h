@@ -1,0 +1,119 @@
+// Segmentation of the proxy's points in a depth frame (DuploTrack-style, Gupta et al. 2012): the
+// play-area volume above the estimated table plane, minus a per-pixel background model of what
+// stands still, minus the animator's hand by skin colour (YCrCb box, Chai and Ngan 1999; OpenCV),
+// split into connected components (OpenCV) of which small ones are dropped as noise.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/rgbd_frame.h"
+#include "core/rigid3.h"
+#include "track/setup.h"
+
+namespace mmh::track {
+
+struct SegmentationOptions {
+  // Every pixel_step-th pixel and row of the play area's image is examined [px].
+  int pixel_step = 1;
+  // The play volume: the play area grown by play_area_margin [m] on each side, from min_height
+  // (above the table's noise and the tape) to max_height above the table plane [m].
+  double play_area_margin = 0.03;
+  double min_height = 0.008;
+  double max_height = 0.30;
+  // Background model: a pixel whose depth stays within background_tolerance [m] of its running
+  // mean for background_frames frames becomes background; foreground needs to be nearer than the
+  // background by background_margin [m]. Pixels covered by the tracked proxy are not learnt.
+  bool background = true;
+  int background_frames = 90;
+  double background_tolerance = 0.01;
+  double background_margin = 0.02;
+  // Skin: colour in the YCrCb box (Chai and Ngan 1999, Cr 133..173, Cb 77..127). Skin pixels are
+  // kept apart: the tracker uses them only where they lie on the proxy's model (a skin-coloured
+  // head), so the hand holding the proxy does not pull it.
+  bool skin = true;
+  int skin_cr_min = 133;
+  int skin_cr_max = 173;
+  int skin_cb_min = 77;
+  int skin_cb_max = 127;
+  // Connected components (8-neighbourhood of foreground pixels) with fewer pixels are dropped.
+  int min_component_pixels = 25;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("pixel_step", pixel_step);
+    v("play_area_margin", play_area_margin);
+    v("min_height", min_height);
+    v("max_height", max_height);
+    v("background", background);
+    v("background_frames", background_frames);
+    v("background_tolerance", background_tolerance);
+    v("background_margin", background_margin);
+    v("skin", skin);
+    v("skin_cr_min", skin_cr_min);
+    v("skin_cr_max", skin_cr_max);
+    v("skin_cb_min", skin_cb_min);
+    v("skin_cb_max", skin_cb_max);
+    v("min_component_pixels", min_component_pixels);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+// An image rectangle [x0, x1) x [y0, y1) [px].
+struct ImageRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+};
+
+struct Segmentation {
+  // Camera-frame points [m] of the proxy candidates (not skin), their component (0-based, in
+  // decreasing size) and pixel index.
+  std::vector<Eigen::Vector3f> points;
+  std::vector<int> components;
+  // Skin-coloured foreground points [m] (the hand, or skin-coloured parts of the proxy).
+  std::vector<Eigen::Vector3f> skin_points;
+  // Pixel counts of the kept components, largest first.
+  std::vector<int> component_sizes;
+  int foreground_pixels = 0;  // in the play volume and before the background
+  int skin_pixels = 0;
+  int dropped_pixels = 0;  // in components under min_component_pixels
+  ImageRect roi;           // the play volume's image
+};
+
+class Segmenter {
+ public:
+  // Validates the options (prefix "segmentation").
+  Segmenter(const SegmentationOptions& options, const TrackSetup& setup);
+
+  // Fixes the geometry: the table frame in the camera and the intrinsics of the depth frames.
+  void SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& intrinsics);
+  bool has_table() const { return has_table_; }
+
+  // Segments `frame` (of the intrinsics given to SetTable) into `out`.
+  void Segment(const RgbdFrame& frame, Segmentation* out);
+
+  // Learns the background from `frame`, leaving out `exclude` (the tracked proxy's image).
+  void UpdateBackground(const RgbdFrame& frame, const ImageRect& exclude);
+
+  const SegmentationOptions& options() const { return options_; }
+
+ private:
+  SegmentationOptions options_;
+  TrackSetup setup_;
+  bool has_table_ = false;
+  PinholeIntrinsics intrinsics_;
+  Rigid3 table_T_camera_;
+  ImageRect roi_;
+  // Per ROI pixel: the table-frame direction of its ray per metre of depth (#roi pixels by 3).
+  std::vector<Eigen::Vector3f> table_rays_;
+  // Per ROI pixel: background depth [m] (0: none yet), running mean and its count.
+  std::vector<float> background_;
+  std::vector<float> running_;
+  std::vector<uint16_t> stable_;
+  // Scratch.
+  std::vector<uint8_t> mask_;
+};
+
+}  // namespace mmh::track

@@ -1,0 +1,124 @@
+#include "track/slider_reader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
+
+namespace mmh::track {
+
+void SliderReaderOptions::Validate(const std::string& prefix) const {
+  auto in_range = [&](int value, int lo, int hi, const char* name) {
+    if (value < lo || value > hi) {
+      ThrowBadValue(prefix + "." + name, std::to_string(value),
+                    "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    }
+  };
+  in_range(hue_min, 0, 180, "hue_min");
+  in_range(hue_max, hue_min, 180, "hue_max");
+  in_range(saturation_min, 0, 255, "saturation_min");
+  in_range(value_min, 0, 255, "value_min");
+  RequireNonNegative(min_height, prefix + ".min_height", "m");
+  RequireNonNegative(max_height_margin, prefix + ".max_height_margin", "m");
+  RequireNonNegative(box_margin, prefix + ".box_margin", "m");
+  if (!(edge_quantile >= 0 && edge_quantile < 0.5)) {
+    ThrowBadValue(prefix + ".edge_quantile", FormatNumber(edge_quantile), "a value in [0, 0.5)");
+  }
+  in_range(min_points, 1, 1000000, "min_points");
+}
+
+SliderReader::SliderReader(const TrackSetup& setup, const SliderReaderOptions& options)
+    : setup_(setup), options_(options) {
+  options_.Validate("slider");
+  setup_.Validate("setup");
+  if (!setup_.has_like_box()) {
+    throw InputError("setup: like_box_length is 0: there is no Like box to read the slider from");
+  }
+}
+
+SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_table) {
+  SliderReading reading;
+  const PinholeIntrinsics& k = frame.depth_intrinsics;
+  const bool registered = frame.depth.size() == static_cast<size_t>(k.pixel_count()) &&
+                          frame.rgb.size() == static_cast<size_t>(3 * k.pixel_count()) &&
+                          frame.color_intrinsics == k &&
+                          frame.color_T_depth.translation.norm() < 1e-9 &&
+                          std::abs(std::abs(frame.color_T_depth.rotation.w()) - 1) < 1e-12;
+  if (!registered) {
+    reading.reason = "no colour image registered to the depth image";
+    return reading;
+  }
+  // The box's image: its corners' projections, grown by the margin and the block's height.
+  const double hx = setup_.like_box_length / 2 + options_.box_margin;
+  const double hy = setup_.like_box_width / 2 + options_.box_margin;
+  const double top = setup_.slider_block_size + options_.max_height_margin;
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d table_p(setup_.like_box_center_x + ((c & 1) ? hx : -hx),
+                                  setup_.like_box_center_y + ((c & 2) ? hy : -hy),
+                                  (c & 4) ? top : 0.0);
+    const Eigen::Vector3d camera_p = camera_T_table * table_p;
+    if (camera_p.z() < 0.05) {
+      reading.reason = "the Like box is behind the camera";
+      return reading;
+    }
+    const Eigen::Vector2d uv = k.Project(camera_p);
+    u0 = std::min(u0, uv.x());
+    v0 = std::min(v0, uv.y());
+    u1 = std::max(u1, uv.x());
+    v1 = std::max(v1, uv.y());
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor(u0)), 0, k.width);
+  const int y0 = std::clamp(static_cast<int>(std::floor(v0)), 0, k.height);
+  const int x1 = std::clamp(static_cast<int>(std::ceil(u1)) + 1, 0, k.width);
+  const int y1 = std::clamp(static_cast<int>(std::ceil(v1)) + 1, 0, k.height);
+  if (x1 <= x0 || y1 <= y0) {
+    reading.reason = "the Like box is outside the image";
+    return reading;
+  }
+  const cv::Mat rgb(k.height, k.width, CV_8UC3, const_cast<uint8_t*>(frame.rgb.data()));
+  cv::Mat hsv, green;
+  cv::cvtColor(rgb(cv::Rect(x0, y0, x1 - x0, y1 - y0)), hsv, cv::COLOR_RGB2HSV);
+  cv::inRange(hsv, cv::Scalar(options_.hue_min, options_.saturation_min, options_.value_min),
+              cv::Scalar(options_.hue_max, 255, 255), green);
+
+  const Rigid3 table_T_camera = camera_T_table.Inverse();
+  xs_.clear();
+  for (int v = y0; v < y1; ++v) {
+    for (int u = x0; u < x1; ++u) {
+      if (!green.at<uint8_t>(v - y0, u - x0)) continue;
+      const uint16_t d = frame.depth[static_cast<size_t>(v) * k.width + u];
+      if (d == 0) continue;
+      const Eigen::Vector3d table_p = table_T_camera * k.BackProject(u, v, d * frame.depth_scale);
+      if (table_p.z() < options_.min_height || table_p.z() > top ||
+          std::abs(table_p.x() - setup_.like_box_center_x) > hx ||
+          std::abs(table_p.y() - setup_.like_box_center_y) > hy) {
+        continue;
+      }
+      xs_.push_back(static_cast<float>(table_p.x()));
+    }
+  }
+  reading.points = static_cast<int>(xs_.size());
+  if (reading.points < options_.min_points) {
+    reading.reason =
+        "no green block in the Like box (" + std::to_string(reading.points) + " points)";
+    return reading;
+  }
+  auto quantile = [&](double q) {
+    const size_t i = std::min(xs_.size() - 1, static_cast<size_t>(q * (xs_.size() - 1) + 0.5));
+    std::nth_element(xs_.begin(), xs_.begin() + i, xs_.end());
+    return static_cast<double>(xs_[i]);
+  };
+  const double lo = quantile(options_.edge_quantile);
+  const double hi = quantile(1 - options_.edge_quantile);
+  reading.center_x = 0.5 * (lo + hi);
+  const double travel = (setup_.like_box_length - setup_.slider_block_size) / 2;
+  reading.raw_value = 5.0 * (reading.center_x - setup_.like_box_center_x) / travel;
+  reading.value = std::clamp(reading.raw_value, -5.0, 5.0);
+  reading.found = true;
+  return reading;
+}
+
+}  // namespace mmh::track
