@@ -116,8 +116,9 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
   const Eigen::Matrix3f r = q.toRotationMatrix().cast<float>();
   const Eigen::Vector3f t = translation.cast<float>();
   const float inlier = static_cast<float>(options.inlier_distance);
+  const float extra_inlier = std::min(inlier, extra);
   double sum = 0.0;
-  for (size_t i = 0; i < scored; ++i) {
+  for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f rp = r * points[i];
     const Eigen::Vector3f s = rp + t;
     const int c = model.Closest(s);
@@ -125,6 +126,10 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
     const Eigen::Vector3f& n = model_normals[c];
     if (n.dot(rp) >= 0) continue;
     const Eigen::Vector3f d = s - model_points[c];
+    if (i >= scored) {
+      result.extra_inliers += d.squaredNorm() <= extra_inlier * extra_inlier;
+      continue;
+    }
     if (d.squaredNorm() > inlier * inlier) continue;
     const float residual = n.dot(d);
     sum += static_cast<double>(residual) * residual;

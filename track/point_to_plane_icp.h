@@ -53,6 +53,9 @@ struct IcpResult {
   // residual [m].
   int inliers = 0;
   double inlier_share = 0.0;
+  // Of the other points: those within min(inlier_distance, extra_distance) of a camera-facing
+  // model surface.
+  int extra_inliers = 0;
   double rms = 0.0;
 };
 

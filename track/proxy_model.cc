@@ -62,6 +62,9 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
   }
   center_ = (0.5 * (bounds.min + bounds.max)).cast<float>();
   radius_ = static_cast<float>(0.5 * size.norm());
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& p : points_) sum += p.cast<double>();
+  centroid_ = (sum / static_cast<double>(points_.size())).cast<float>();
   // Sparse subset: one sample per 4 mm cell and normal direction (the dominant axis and its sign,
   // so that both sides of a thin part keep samples).
   {

@@ -54,6 +54,8 @@ class ProxyModel {
   // Centre of the bounding box and the radius of its bounding sphere [m], model frame.
   const Eigen::Vector3f& center() const { return center_; }
   float radius() const { return radius_; }
+  // Mean of the surface samples (the area centroid) [m], model frame.
+  const Eigen::Vector3f& centroid() const { return centroid_; }
   const ProxyModelOptions& options() const { return options_; }
   // A second, sparser set of samples (about 4 mm apart) for the free-space check.
   const std::vector<int>& sparse_samples() const { return sparse_; }
@@ -69,6 +71,7 @@ class ProxyModel {
   std::vector<int32_t> grid_;
   Eigen::Vector3f center_ = Eigen::Vector3f::Zero();
   float radius_ = 0;
+  Eigen::Vector3f centroid_ = Eigen::Vector3f::Zero();
 };
 
 }  // namespace mmh::track

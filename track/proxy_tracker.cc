@@ -34,6 +34,13 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   if (candidates < 1) ThrowBadValue(prefix + ".candidates", std::to_string(candidates), ">= 1");
   RequirePositive(coarse_start_distance, prefix + ".coarse_start_distance", "m");
   RequirePositive(coarse_end_distance, prefix + ".coarse_end_distance", "m");
+  RequirePositive(recheck_rotation_deg, prefix + ".recheck_rotation_deg", "deg");
+  RequirePositive(recheck_translation, prefix + ".recheck_translation", "m");
+  if (recheck_interval < 0) {
+    ThrowBadValue(prefix + ".recheck_interval", std::to_string(recheck_interval),
+                  ">= 0 (0: never)");
+  }
+  RequireNonNegative(switch_margin, prefix + ".switch_margin");
   if (coarse_end_distance > coarse_start_distance) {
     ThrowBadValue(prefix + ".coarse_end_distance", FormatNumber(coarse_end_distance),
                   "at most coarse_start_distance");
@@ -68,9 +75,20 @@ void ProxyTrackerOptions::Validate(const std::string& prefix) const {
 struct ProxyTracker::Candidate {
   IcpResult icp;
   double free_space_violation = 0.0;
+  double explained = 0.0;
   bool good = false;
   std::string reason;
-  double Score() const { return icp.inlier_share - free_space_violation; }
+  // Ranks verified poses: the data the model explains (segmented and skin-coloured points within
+  // reach of its surface, per segmented point), less twice the share of the model surfaces the
+  // camera sees through. Near-symmetric proxies (the Soldier's body is
+  // symmetric under a half turn; only its rifle is not) are told apart by both. (The share of the
+  // model the data confirms is no guide: the hand in front of the model confirms a wrong pose.)
+  double Score() const {
+    const double explained =
+        icp.inlier_share > 0 ? icp.inlier_share * (icp.inliers + icp.extra_inliers) / icp.inliers
+                             : 0.0;
+    return explained - 2 * free_space_violation;
+  }
 };
 
 ProxyTracker::ProxyTracker(const TriangleMesh& model, const std::string& model_name,
@@ -117,13 +135,13 @@ ImageRect ProxyTracker::ProxyImage(const Rigid3& camera_T_proxy) const {
           std::clamp(static_cast<int>(uv.y() + r) + 1, 0, k.height)};
 }
 
-double ProxyTracker::FreeSpaceViolation(const RgbdFrame& frame,
-                                        const Rigid3& camera_T_proxy) const {
+ProxyTracker::Visibility ProxyTracker::ModelVisibility(const RgbdFrame& frame,
+                                                       const Rigid3& camera_T_proxy) const {
   const PinholeIntrinsics& k = frame.depth_intrinsics;
   const Eigen::Matrix3f r = camera_T_proxy.rotation.toRotationMatrix().cast<float>();
   const Eigen::Vector3f t = camera_T_proxy.translation.cast<float>();
   const float margin = static_cast<float>(options_.verification.free_space_margin);
-  int seen = 0, violations = 0;
+  int seen = 0, violations = 0, explained = 0;
   for (int i : model_->sparse_samples()) {
     const Eigen::Vector3f c = r * model_->points()[i] + t;
     if (c.z() <= 0.05f || (r * model_->normals()[i]).dot(c) >= 0) continue;
@@ -133,9 +151,17 @@ double ProxyTracker::FreeSpaceViolation(const RgbdFrame& frame,
     const uint16_t d = frame.depth[static_cast<size_t>(v) * k.width + u];
     if (d == 0) continue;
     ++seen;
-    if (d * static_cast<float>(frame.depth_scale) > c.z() + margin) ++violations;
+    const float z = d * static_cast<float>(frame.depth_scale);
+    if (z > c.z() + margin) {
+      ++violations;
+    } else if (z >= c.z() - margin) {
+      ++explained;
+    }
   }
-  return seen > 0 ? static_cast<double>(violations) / seen : 1.0;
+  Visibility visibility;
+  visibility.violation = seen > 0 ? static_cast<double>(violations) / seen : 1.0;
+  visibility.explained = seen > 0 ? static_cast<double>(explained) / seen : 0.0;
+  return visibility;
 }
 
 ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpResult& icp) const {
@@ -143,7 +169,9 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   Candidate candidate;
   candidate.icp = icp;
   const Rigid3 camera_T_proxy = icp.proxy_T_camera.Inverse();
-  candidate.free_space_violation = FreeSpaceViolation(frame, camera_T_proxy);
+  const Visibility visibility = ModelVisibility(frame, camera_T_proxy);
+  candidate.free_space_violation = visibility.violation;
+  candidate.explained = visibility.explained;
   const Eigen::Vector3d table_c =
       camera_T_table_->Inverse() * (camera_T_proxy * model_->center().cast<double>());
   auto text = [](double value) { return FormatNumber(std::round(value * 1e4) / 1e4); };
@@ -166,7 +194,8 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   return candidate;
 }
 
-std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& frame) {
+std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
+    const RgbdFrame& frame, const std::optional<Rigid3>& predicted) {
   const DetectionOptions& o = options_.detection;
   // The largest segment (component 0), evenly subsampled.
   std::vector<Eigen::Vector3f> segment;
@@ -180,6 +209,14 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   std::vector<Eigen::Vector3f> coarse;
   const size_t stride = std::max<size_t>(1, segment.size() / o.coarse_points);
   for (size_t i = 0; i < segment.size(); i += stride) coarse.push_back(segment[i]);
+  const size_t coarse_scored = coarse.size();
+  // Skin-coloured points as many again at most: they count where they lie on the model (a
+  // skin-coloured head or part tells a pose from its near-symmetric twins).
+  const size_t skin_stride =
+      std::max<size_t>(1, segmentation_.skin_points.size() / std::max<size_t>(1, coarse_scored));
+  for (size_t i = 0; i < segmentation_.skin_points.size(); i += skin_stride) {
+    coarse.push_back(segmentation_.skin_points[i]);
+  }
 
   // Orientations: the model's +z, -z, +x, -x, +y, -y up, each at yaw_steps yaws about the table
   // normal.
@@ -209,30 +246,105 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
       const Eigen::Quaterniond camera_R_proxy = (camera_R_table * yaw * up).normalized();
       const Rigid3 camera_T_proxy(camera_R_proxy,
                                   center_guess - camera_R_proxy * model_->center().cast<double>());
-      coarse_results.push_back(AlignPointToPlane(*model_, coarse, coarse.size(), 0.0,
+      coarse_results.push_back(AlignPointToPlane(*model_, coarse, coarse_scored,
+                                                 options_.verification.skin_distance,
                                                  camera_T_proxy.Inverse(), coarse_icp));
     }
   }
+  // Rank the coarse results as verified poses are ranked (track/proxy_tracker.h, Score).
+  std::vector<double> scores(coarse_results.size());
+  for (size_t i = 0; i < coarse_results.size(); ++i) {
+    const Visibility visibility =
+        ModelVisibility(frame, coarse_results[i].proxy_T_camera.Inverse());
+    scores[i] = static_cast<double>(coarse_results[i].inliers + coarse_results[i].extra_inliers) /
+                    coarse_scored -
+                2 * visibility.violation;
+  }
   std::vector<size_t> order(coarse_results.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    if (coarse_results[a].inlier_share != coarse_results[b].inlier_share) {
-      return coarse_results[a].inlier_share > coarse_results[b].inlier_share;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return scores[a] > scores[b]; });
+  // Refine the best coarse results until `candidates` distinct poses are verified (hypotheses
+  // converge to a few poses: each counts once).
+  auto same_pose = [](const Rigid3& a, const Rigid3& b) {
+    return RotationAngle(a.rotation, b.rotation) < 0.1 &&
+           (a.translation - b.translation).norm() < 0.01;
+  };
+  // Verified beats unverified; then the score, except that among poses scoring within
+  // switch_margin of each other the one nearer the prediction wins (when the views of a
+  // near-symmetric proxy cannot tell its twins apart, continuity can).
+  auto distance_to_prediction = [&](const Candidate& c) {
+    return RotationAngle(c.icp.proxy_T_camera.Inverse().rotation, predicted->rotation);
+  };
+  auto better = [&](const Candidate& a, const std::optional<Candidate>& b) {
+    if (!b) return true;
+    if (a.good != b->good) return a.good;
+    if (predicted && std::abs(a.Score() - b->Score()) <= o.switch_margin) {
+      return distance_to_prediction(a) < distance_to_prediction(*b);
     }
-    return coarse_results[a].rms < coarse_results[b].rms;
-  });
+    return a.Score() > b->Score();
+  };
+  std::vector<Rigid3> refined_poses;
   std::optional<Candidate> best;
-  for (int c = 0; c < std::min<int>(o.candidates, static_cast<int>(order.size())); ++c) {
+  for (size_t c = 0; c < order.size() && static_cast<int>(refined_poses.size()) < o.candidates &&
+                     c < static_cast<size_t>(3 * o.candidates);
+       ++c) {
     const IcpResult refined =
         AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
                           coarse_results[order[c]].proxy_T_camera, options_.icp);
+    if (std::any_of(refined_poses.begin(), refined_poses.end(),
+                    [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
+      continue;
+    }
+    refined_poses.push_back(refined.proxy_T_camera);
     Candidate candidate = Verify(frame, refined);
-    if (!best || (candidate.good && !best->good) ||
-        (candidate.good == best->good && candidate.Score() > best->Score())) {
-      best = candidate;
+    if (better(candidate, best)) best = candidate;
+  }
+  // Near-symmetric twins of the best pose: turned by quarter turns about the model's own axes
+  // through its centre (a proxy built from bricks is often symmetric but for a small part, which
+  // the coarse ranking cannot see).
+  if (best && o.twins) {
+    const Rigid3 camera_T_proxy = best->icp.proxy_T_camera.Inverse();
+    const Eigen::Vector3d center = model_->centroid().cast<double>();
+    const Candidate original = *best;
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int quarter = 1; quarter <= 3; ++quarter) {
+        // proxy_T_twin: the turn about the centre, in the model's frame.
+        const Eigen::Quaterniond turn(
+            Eigen::AngleAxisd(quarter * pi / 2, Eigen::Vector3d::Unit(axis)));
+        const Rigid3 proxy_T_twin(turn, center - turn * center);
+        // Coarse first (the turn about the centre need not be the symmetry's), then fine.
+        const IcpResult coarse_twin =
+            AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                              (camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp);
+        const IcpResult refined =
+            AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                              coarse_twin.proxy_T_camera, options_.icp);
+        if (same_pose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
+        Candidate candidate = Verify(frame, refined);
+        if (better(candidate, best)) best = candidate;
+      }
     }
   }
   return best;
+}
+
+ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
+                                                const Rigid3& camera_T_proxy) const {
+  PoseScore score;
+  if (!camera_T_table_) return score;
+  const IcpResult icp =
+      AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                        camera_T_proxy.Inverse(), options_.icp);
+  const Candidate candidate = Verify(frame, icp);
+  score.camera_T_proxy = icp.proxy_T_camera.Inverse();
+  score.inlier_share = icp.inlier_share;
+  score.rms = icp.rms;
+  score.free_space_violation = candidate.free_space_violation;
+  score.explained = candidate.explained;
+  score.score = candidate.Score();
+  score.good = candidate.good;
+  return score;
 }
 
 TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
@@ -305,9 +417,28 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     } else {
       why = candidate.reason;
     }
+    // A large correction of the prediction, or the periodic check, also asks the global detection
+    // (a jump can land the ICP on a near-symmetric twin of the true pose, which verifies).
+    const Rigid3 corrected = icp.proxy_T_camera.Inverse();
+    const DetectionOptions& d = options_.detection;
+    ++frames_since_detection_;
+    if (chosen && (RotationAngle(corrected.rotation, predicted.rotation) >
+                       d.recheck_rotation_deg * std::numbers::pi / 180 ||
+                   (corrected.translation - predicted.translation).norm() > d.recheck_translation ||
+                   (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
+      frames_since_detection_ = 0;
+      std::optional<Candidate> detected = Detect(frame, predicted);
+      if (detected && detected->good && detected->Score() > chosen->Score() + d.switch_margin) {
+        chosen = detected;
+        result.detected = true;
+      }
+    }
   }
   if (!chosen && enough) {
-    std::optional<Candidate> detected = Detect(frame);
+    std::optional<Candidate> detected =
+        Detect(frame, last_ ? std::optional<Rigid3>(velocity_ ? *velocity_ * *last_ : *last_)
+                            : std::nullopt);
+    frames_since_detection_ = 0;
     if (detected && detected->good) {
       chosen = detected;
       result.detected = true;

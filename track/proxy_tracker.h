@@ -36,13 +36,23 @@ struct DetectionOptions {
   int yaw_steps = 12;
   bool all_faces_up = true;
   // Each hypothesis is aligned with this many points of the largest segment for
-  // coarse_iterations; the best `candidates` are refined with all points and verified.
+  // coarse_iterations; the best `candidates` distinct results are refined with all points,
+  // verified and ranked.
   int coarse_points = 200;
   int coarse_iterations = 10;
-  int candidates = 4;
+  int candidates = 10;
   // Rejection distance of the coarse alignment [m] (start, end).
   double coarse_start_distance = 0.03;
   double coarse_end_distance = 0.008;
+  // Also try the best pose turned by quarter turns about the model's axes (near-symmetric proxies).
+  bool twins = true;
+  // While tracking, the detection also runs when the ICP corrects the prediction by more than
+  // recheck_rotation_deg [deg] or recheck_translation [m], and every recheck_interval frames
+  // (0: never); its pose replaces the tracked one when it scores switch_margin higher.
+  double recheck_rotation_deg = 20.0;
+  double recheck_translation = 0.03;
+  int recheck_interval = 15;
+  double switch_margin = 0.05;
 
   template <class V>
   void VisitFields(V& v) {
@@ -53,6 +63,11 @@ struct DetectionOptions {
     v("candidates", candidates);
     v("coarse_start_distance", coarse_start_distance);
     v("coarse_end_distance", coarse_end_distance);
+    v("twins", twins);
+    v("recheck_rotation_deg", recheck_rotation_deg);
+    v("recheck_translation", recheck_translation);
+    v("recheck_interval", recheck_interval);
+    v("switch_margin", switch_margin);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -62,7 +77,7 @@ struct VerificationOptions {
   int min_points = 60;
   // Inlier share (of the segmented points, within icp.inlier_distance) at least, and inlier RMS
   // point-to-plane residual at most [m].
-  double min_inlier_share = 0.55;
+  double min_inlier_share = 0.75;
   double max_rms = 0.004;
   // Free space: of the model's camera-facing samples with a depth reading, at most this share may
   // show a depth more than free_space_margin [m] behind the model.
@@ -145,6 +160,16 @@ class ProxyTracker {
   // The frame could not be read (FrameSource::frame_error): lost with that reason.
   TrackFrameResult Unreadable(const RgbdFrame& frame, const std::string& error);
 
+  // Refines `camera_T_proxy` against the frame last passed to Track() (the same frame) and scores
+  // it as the tracker ranks candidate poses (for diagnostics and tests): returns the refined pose
+  // with its inlier share, residual, free-space violation, explained share and score.
+  struct PoseScore {
+    Rigid3 camera_T_proxy;
+    double inlier_share = 0.0, rms = 0.0, free_space_violation = 0.0, explained = 0.0, score = 0.0;
+    bool good = false;
+  };
+  PoseScore ScorePose(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
+
   // The table frame in the depth camera (from the estimated plane); nullopt before the first
   // frame with a plane.
   const std::optional<Rigid3>& camera_T_table() const { return camera_T_table_; }
@@ -155,9 +180,16 @@ class ProxyTracker {
  private:
   struct Candidate;
   bool EnsureTable(const RgbdFrame& frame, std::string* why);
-  std::optional<Candidate> Detect(const RgbdFrame& frame);
+  // The global detection; `predicted` (the motion model's pose, when there is one) breaks ties.
+  std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted);
   Candidate Verify(const RgbdFrame& frame, const IcpResult& icp) const;
-  double FreeSpaceViolation(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
+  // Of the model's camera-facing sparse samples with a depth reading: the share whose depth the
+  // frame confirms (within free_space_margin) and the share it sees behind (free space).
+  struct Visibility {
+    double explained = 0.0;
+    double violation = 0.0;
+  };
+  Visibility ModelVisibility(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
   ImageRect ProxyImage(const Rigid3& camera_T_proxy) const;
 
   ProxyTrackerOptions options_;
@@ -172,6 +204,7 @@ class ProxyTracker {
   std::optional<Rigid3> last_;
   std::optional<Rigid3> velocity_;  // last * previous^-1 (camera frame, per frame)
   int predicted_frames_ = 0;
+  int frames_since_detection_ = 0;
   // Scratch: the subsampled segmented points (the first scored_), then the skin points.
   std::vector<Eigen::Vector3f> data_;
   size_t scored_ = 0;

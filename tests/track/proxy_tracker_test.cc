@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <optional>
@@ -42,6 +44,7 @@ TakeResult TrackTake(test_take::SimTake& take, int frames,
   const metrics::PoseErrorOptions metric_options;
   const auto errors = metrics::ComputePoseErrors(estimates, truth, points, metric_options);
   result.summary = metrics::SummarizeTracking(errors, metrics::Diameter(points), metric_options);
+  // The failed frames, for the log.
   for (size_t i = 0; i < errors.size(); ++i) {
     if (!errors[i].success) {
       std::printf(
@@ -57,12 +60,64 @@ TakeResult TrackTake(test_take::SimTake& take, int frames,
   return result;
 }
 
+// The accuracy thresholds on the demo walk (8 s a round, stepping bounce, yaw swings) with
+// the full Kinect noise and the hand holding the proxy.
 TEST(ProxyTrackerTest, DemoWalkWithHand) {
   test_take::SimTake take;
-  const TakeResult result = TrackTake(take, 150);
+  const TakeResult result = TrackTake(take, 240);
   EXPECT_LE(result.summary.median_rotation_deg, 1.0);
   EXPECT_LE(result.summary.median_translation, 0.002);
   EXPECT_GE(result.summary.success_rate, 0.99);
+}
+
+// A fast take: the walk at twice the demo's speed with a tumbling tilt of up to 20 deg and wide
+// yaw swings (up to about 6 mm and 4 deg per frame).
+Rigid3 FastTableTProxy(double t) {
+  sim::DemoMotionOptions fast;
+  fast.round_period = 4.0;
+  fast.step_rate = 3.0;
+  fast.yaw_swing = 0.5;
+  const Rigid3 walk = fast.TableTProxy(t);
+  const double tilt = 0.35 * std::sin(2 * std::numbers::pi * 0.9 * t);
+  const Eigen::Quaterniond tumble(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()));
+  // Lift it so that a tilted figure stays above the table.
+  return Rigid3(walk.rotation * tumble, walk.translation + Eigen::Vector3d(0, 0, 0.03));
+}
+
+TEST(ProxyTrackerTest, FastTumblingWithHand) {
+  test_take::SimTake take({}, FastTableTProxy);
+  const TakeResult result = TrackTake(take, 200);
+  EXPECT_LE(result.summary.median_rotation_deg, 1.0);
+  EXPECT_LE(result.summary.median_translation, 0.002);
+  // Tilted under the hand, the boxy Soldier shows little more than one face for a few frames:
+  // single frames reach 5-7 deg (documented in docs/tracker.md), never for long.
+  EXPECT_GE(result.summary.success_rate, 0.97);
+  EXPECT_LE(result.summary.longest_failure, 3);
+}
+
+// Jumps the ICP cannot follow (8 cm and 100 deg between two frames, as when the animator lifts
+// the proxy out of the camera's view and puts it back elsewhere): each is detected as a loss, and
+// the global detection recovers within 15 frames; no frame reported as tracked is far off.
+Rigid3 JumpingTableTProxy(double t) {
+  const Rigid3 walk = sim::DemoMotionOptions().TableTProxy(t);
+  const int segment = static_cast<int>(t / 2.0);
+  const double yaw = segment * 1.75;
+  const Eigen::Vector3d shift =
+      segment % 2 ? Eigen::Vector3d(-0.08, 0.02, 0) : Eigen::Vector3d::Zero();
+  return Rigid3(
+      Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ())) * walk.rotation,
+      walk.translation + shift);
+}
+
+TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
+  test_take::SimTake take({}, JumpingTableTProxy);
+  const TakeResult result = TrackTake(take, 200);  // jumps at frames 60, 120, 180
+  EXPECT_TRUE(result.summary.all_recovered);
+  EXPECT_LE(result.summary.longest_failure, 15);
+  EXPECT_GE(result.summary.success_rate, 0.95);
+  int detections = 0;
+  for (const auto& frame : result.frames) detections += frame.detected;
+  EXPECT_GE(detections, 4);  // the first frame and each jump
 }
 
 }  // namespace
