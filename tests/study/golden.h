@@ -19,11 +19,14 @@ namespace mmh::study::golden {
 // The matching tolerance of the issue: 1e-10 relative.
 inline constexpr double kRelative = 1e-10;
 
+inline nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
 inline const nlohmann::json& Golden() {
-  static const nlohmann::json golden = [] {
-    std::ifstream in(std::filesystem::path(MMH_TEST_DATA_DIR) / "study" / "golden.json");
-    return nlohmann::json::parse(in);
-  }();
+  static const nlohmann::json golden =
+      ReadJsonFile(std::filesystem::path(MMH_TEST_DATA_DIR) / "study" / "golden.json");
   return golden;
 }
 
