@@ -1,0 +1,80 @@
+// The slider reader against the rendered block's true value, on simulated frames with the full
+// Kinect noise and the hand, in the table frame the tracker estimates (RANSAC plane).
+#include "track/slider_reader.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/test_util.h"
+#include "tests/track/sim_take.h"
+#include "track/table_plane.h"
+
+namespace mmh::track {
+namespace {
+
+using test_util::ErrorOf;
+using ::testing::HasSubstr;
+
+TEST(SliderReaderTest, ValueRmseAgainstTheRenderedBlock) {
+  test_take::SimTake take;
+  const TrackSetup setup = take.Setup();
+  SliderReader reader(setup, SliderReaderOptions());
+  std::optional<Rigid3> camera_T_table;
+  double sum = 0.0, worst = 0.0;
+  int found = 0;
+  constexpr int kFrames = 150;  // the demo sweep: -5..+5 and back in 5 s
+  for (int i = 0; i < kFrames; ++i) {
+    double truth = 0.0;
+    const RgbdFrame frame = take.Render(i, nullptr, &truth);
+    if (!camera_T_table) {
+      std::string why;
+      const auto plane = EstimateTablePlane(frame, TablePlaneOptions(), setup.camera_T_table, &why);
+      ASSERT_TRUE(plane) << why;
+      camera_T_table = TableFrameOnPlane(*plane, setup.camera_T_table);
+    }
+    const SliderReading reading = reader.Read(frame, *camera_T_table);
+    ASSERT_TRUE(reading.found) << "frame " << i << ": " << reading.reason;
+    ++found;
+    const double error = reading.value - truth;
+    sum += error * error;
+    worst = std::max(worst, std::abs(error));
+  }
+  const double rmse = std::sqrt(sum / found);
+  std::printf("slider RMSE %.3f, worst %.3f over %d frames\n", rmse, worst, found);
+  EXPECT_LE(rmse, 0.3);
+  EXPECT_LE(worst, 1.0);
+}
+
+TEST(SliderReaderTest, MissingBlockAndBadFramesAreReported) {
+  test_take::SimTake take;
+  const TrackSetup setup = take.Setup();
+  SliderReader reader(setup, SliderReaderOptions());
+  RgbdFrame frame = take.Render(0);
+  const Rigid3 camera_T_table = *setup.camera_T_table;
+  // The block painted over (grey): nothing green in the Like box.
+  RgbdFrame grey = frame;
+  for (size_t i = 0; i < grey.rgb.size(); i += 3) {
+    const uint8_t g = grey.rgb[i + 1];
+    grey.rgb[i] = grey.rgb[i + 1] = grey.rgb[i + 2] = g;
+  }
+  const SliderReading none = reader.Read(grey, camera_T_table);
+  EXPECT_FALSE(none.found);
+  EXPECT_THAT(none.reason, HasSubstr("no green block in the Like box"));
+  // No colour.
+  RgbdFrame depth_only = frame;
+  depth_only.rgb.clear();
+  EXPECT_THAT(reader.Read(depth_only, camera_T_table).reason, HasSubstr("no colour image"));
+  // A setup without a Like box cannot read a slider.
+  TrackSetup no_box = setup;
+  no_box.like_box_length = 0;
+  EXPECT_THAT(ErrorOf([&] { SliderReader r(no_box, SliderReaderOptions()); }),
+              HasSubstr("no Like box"));
+  SliderReaderOptions bad;
+  bad.hue_max = 10;
+  EXPECT_THAT(ErrorOf([&] { SliderReader r(setup, bad); }), HasSubstr("slider.hue_max"));
+}
+
+}  // namespace
+}  // namespace mmh::track
