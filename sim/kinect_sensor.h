@@ -17,7 +17,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "core/camera.h"
@@ -139,13 +141,18 @@ enum class RenderMode { kIncremental, kFull };
 
 // Time per step [s], summed over frames, and counts.
 struct SensorTimings {
-  double cast = 0.0;       // ray casting
-  double shade = 0.0;      // surface colour of newly cast pixels
+  double cast = 0.0;  // ray casting, with the write-back that shades the newly cast pixels
+  // Surface colour of newly cast pixels: now part of the cast's write-back (counted in `cast`),
+  // always 0; kept for readers of earlier summaries.
+  double shade = 0.0;
+  double restore = 0.0;    // copying the cached static scene back where the last frame changed it
   double occlusion = 0.0;  // projector / IR camera row scans
   double noise = 0.0;      // per-pixel noise, lattice, missing data, output
   uint64_t frames = 0;
   uint64_t rays = 0;
   uint64_t pixels_recast = 0;
+
+  SensorTimings& operator+=(const SensorTimings& other);
 };
 
 class KinectSensor {
@@ -174,9 +181,35 @@ class KinectSensor {
   const SensorTimings& timings() const;
   void ResetTimings();
 
+  // The per-pixel noise runs in hand-written AVX-512 kernels where the CPU has them, otherwise in
+  // portable ones; both give the same bytes. For tests and benchmarks: false selects the portable
+  // kernels for every sensor of the process; returns whether the vector kernels are now in use.
+  static bool SetVectorKernels(bool enabled);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// Frame-level parallelism: several scenes, each with its own sensor, render whole frames at once
+// (a frame is too little work to keep two cores busy from inside). A frame is a pure function of
+// the scene state, the seed and its index, so the frames are exactly those of one sensor rendering
+// them in order, for any number of workers and either mode (tested).
+struct SensorWorker {
+  // Puts this worker's own scene into the state of frame `index` and commits it (for example
+  // TableTopScene::SetFrame with that frame's proxy pose and slider value).
+  std::function<void(int index)> pose_scene;
+  // Renders that scene; the sensor's options must be the same for every worker.
+  KinectSensor* sensor = nullptr;
+};
+
+// Renders frames [first, first + count) on up to workers.size() threads (oneTBB; each worker
+// renders one frame at a time) and hands them to consume in frame order, one call at a time, on
+// any thread. Exceptions from pose_scene, Render or consume stop the run and propagate.
+void RenderFrames(std::span<const SensorWorker> workers, int first, int count, RenderMode mode,
+                  const std::function<void(const RgbdFrame&)>& consume);
+
+// The workers' timings, summed.
+SensorTimings TotalTimings(std::span<const SensorWorker> workers);
 
 }  // namespace mmh::sim

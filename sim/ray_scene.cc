@@ -4,18 +4,21 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
 
 #include "core/error.h"
+#include "core/simd.h"
 
 namespace mmh::sim {
 namespace {
 
-constexpr int kTile = 4;  // 4x4 pixels per 16-ray packet
+constexpr int kTile = HitPacket::kTile;  // 4x4 pixels per 16-ray packet
 
 const char* ErrorName(RTCError code) {
   switch (code) {
@@ -44,6 +47,39 @@ void ToEmbreeTransform(const Rigid3& a_T_b, float out[12]) {
     for (int row = 0; row < 3; ++row) out[c * 3 + row] = static_cast<float>(r(row, c));
   }
   for (int row = 0; row < 3; ++row) out[9 + row] = static_cast<float>(a_T_b.translation[row]);
+}
+
+// Directions of a 4x4 tile's rays: column part of the tile's columns plus row part of its rows
+// (per component; `columns` and `rows` point at the tile's first column and row).
+MMH_SIMD_CLONES void TileDirections(const float* __restrict columns, const float* __restrict rows,
+                                    float* __restrict out) {
+  for (int r = 0; r < kTile; ++r) {
+    for (int c = 0; c < kTile; ++c) out[r * kTile + c] = columns[c] + rows[r];
+  }
+}
+
+// Unit normals facing the camera and incidence cosines of 16 lanes (lanes without a hit compute
+// values nobody reads; no traps).
+MMH_SIMD_CLONES void FinishLanes(const float* __restrict nx_in, const float* __restrict ny_in,
+                                 const float* __restrict nz_in, const float* __restrict dx_in,
+                                 const float* __restrict dy_in, const float* __restrict dz_in,
+                                 const float* __restrict tfar, HitPacket* __restrict out) {
+  for (int i = 0; i < HitPacket::kLanes; ++i) {
+    const float nx = nx_in[i], ny = ny_in[i], nz = nz_in[i];
+    const float dx = dx_in[i], dy = dy_in[i], dz = dz_in[i];
+    const float normal_norm = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const float norms = normal_norm * std::sqrt(dx * dx + dy * dy + dz * dz);
+    const float dot = nx * dx + ny * dy + nz * dz;
+    // Face the camera: the sensor sees the side the ray hits.
+    const float sign = dot > 0 ? -1.0f : 1.0f;
+    const float scale = normal_norm > 0 ? sign / (normal_norm > 0 ? normal_norm : 1.0f) : 1.0f;
+    out->normal_x[i] = nx * scale;
+    out->normal_y[i] = ny * scale;
+    out->normal_z[i] = nz * scale;
+    out->depth[i] = tfar[i];
+    const float ratio = std::abs(dot) / (norms > 0 ? norms : 1.0f);
+    out->cos_incidence[i] = norms > 0 ? (ratio < 1.0f ? ratio : 1.0f) : 0.0f;
+  }
 }
 
 }  // namespace
@@ -290,6 +326,9 @@ const TriangleMesh& RayScene::object_mesh(uint32_t object) const {
   return impl_->objects.at(object).mesh;
 }
 bool RayScene::is_moving(uint32_t object) const { return impl_->objects.at(object).moving; }
+const Rigid3& RayScene::world_T_object(uint32_t object) const {
+  return impl_->objects.at(object).world_T_object;
+}
 uint64_t RayScene::rays_cast() const { return impl_->rays.load(); }
 
 Bounds3 RayScene::WorldBounds(uint32_t object) const {
@@ -309,16 +348,67 @@ Bounds3 RayScene::WorldBounds(uint32_t object) const {
   return bounds;
 }
 
+namespace {
+
+// Writes packets into a HitBuffer (the buffer's own depth bounds kMoving rays).
+class HitBufferSink final : public HitSink {
+ public:
+  HitBufferSink(HitBuffer* hits, int width, bool write_misses)
+      : hits_(hits), width_(width), write_misses_(write_misses) {}
+  void Consume(const HitPacket& packet) override {
+    for (int i = 0; i < HitPacket::kLanes; ++i) {
+      if (!((packet.cast >> i) & 1u)) continue;
+      const int u = packet.u0 + i % HitPacket::kTile;
+      const int v = packet.v0 + i / HitPacket::kTile;
+      const size_t p = static_cast<size_t>(v) * width_ + u;
+      if (!((packet.hit >> i) & 1u)) {
+        if (write_misses_) {
+          hits_->depth[p] = std::numeric_limits<float>::infinity();
+          hits_->object[p] = kNoObject;
+          hits_->face[p] = 0;
+          hits_->cos_incidence[p] = 0.0f;
+        }
+        continue;
+      }
+      hits_->depth[p] = packet.depth[i];
+      hits_->object[p] = packet.object[i];
+      hits_->face[p] = packet.face[i];
+      hits_->cos_incidence[p] = packet.cos_incidence[i];
+      hits_->normal[3 * p] = packet.normal_x[i];
+      hits_->normal[3 * p + 1] = packet.normal_y[i];
+      hits_->normal[3 * p + 2] = packet.normal_z[i];
+    }
+  }
+
+ private:
+  HitBuffer* hits_;
+  int width_;
+  bool write_misses_;
+};
+
+}  // namespace
+
 void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_camera,
                     std::span<const PixelSpan> spans, Target target, HitBuffer* hits) const {
+  if (static_cast<int>(hits->depth.size()) != intrinsics.width * intrinsics.height) {
+    throw std::logic_error("RayScene::Cast: hit buffer of the wrong size");
+  }
+  HitBufferSink sink(hits, intrinsics.width, target != Target::kMoving);
+  Cast(intrinsics, world_T_camera, spans, target,
+       target == Target::kMoving ? hits->depth.data() : nullptr, &sink);
+}
+
+void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_camera,
+                    std::span<const PixelSpan> spans, Target target, const float* max_depth,
+                    HitSink* sink) const {
   const bool moving_only = target == Target::kMoving;
   const Impl& s = *impl_;
   if (!s.static_built) throw std::logic_error("RayScene::Cast before Commit");
+  if (moving_only && max_depth == nullptr) {
+    throw std::logic_error("RayScene::Cast: kMoving needs the depth bound of every pixel");
+  }
   const int width = intrinsics.width;
   const int height = intrinsics.height;
-  if (static_cast<int>(hits->depth.size()) != width * height) {
-    throw std::logic_error("RayScene::Cast: hit buffer of the wrong size");
-  }
   // 16-bit pixel masks of the 4x4 tiles touched by the spans.
   const int tiles_x = (width + kTile - 1) / kTile;
   const int tiles_y = (height + kTile - 1) / kTile;
@@ -327,12 +417,18 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
     if (span.row < 0 || span.row >= height) continue;
     const int first = std::max(span.first, 0);
     const int last = std::min(span.last, width - 1);
-    for (int u = first; u <= last; ++u) {
-      tile_mask[(span.row / kTile) * tiles_x + u / kTile] |=
-          static_cast<uint16_t>(1u << ((span.row % kTile) * kTile + u % kTile));
+    if (first > last) continue;
+    uint16_t* row_masks = &tile_mask[static_cast<size_t>(span.row / kTile) * tiles_x];
+    const int shift = (span.row % kTile) * kTile;
+    for (int t = first / kTile; t <= last / kTile; ++t) {
+      const int a = std::max(first, t * kTile) - t * kTile;
+      const int b = std::min(last, t * kTile + kTile - 1) - t * kTile;
+      const unsigned bits = ((1u << (b + 1)) - 1u) & ~((1u << a) - 1u);
+      row_masks[t] |= static_cast<uint16_t>(bits << shift);
     }
   }
   std::vector<int> tiles;
+  tiles.reserve(tile_mask.size());
   for (int t = 0; t < static_cast<int>(tile_mask.size()); ++t) {
     if (tile_mask[t] != 0) tiles.push_back(t);
   }
@@ -356,90 +452,114 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
   }
 
   // Ray directions are x_u * R.col(0) + y_v * R.col(1) + R.col(2) with x_u = (u - cx) / fx and
-  // y_v = (v - cy) / fy: precomputed per column and row, three additions per ray.
-  std::vector<Eigen::Vector3f> column_part(width), row_part(height);
-  for (int u = 0; u < width; ++u) {
-    column_part[u] =
+  // y_v = (v - cy) / fy: precomputed per column and row (padded to whole tiles), one addition per
+  // component and ray.
+  const int padded_width = tiles_x * kTile;
+  const int padded_height = tiles_y * kTile;
+  std::vector<float> column_part(3 * static_cast<size_t>(padded_width));
+  std::vector<float> row_part(3 * static_cast<size_t>(padded_height));
+  for (int u = 0; u < padded_width; ++u) {
+    const Eigen::Vector3f c =
         world_R_camera.col(0) * static_cast<float>((u - intrinsics.cx) / intrinsics.fx);
+    for (int k = 0; k < 3; ++k) column_part[k * padded_width + u] = c[k];
   }
-  for (int v = 0; v < height; ++v) {
-    row_part[v] = world_R_camera.col(1) * static_cast<float>((v - intrinsics.cy) / intrinsics.fy) +
-                  world_R_camera.col(2);
+  for (int v = 0; v < padded_height; ++v) {
+    const Eigen::Vector3f r =
+        world_R_camera.col(1) * static_cast<float>((v - intrinsics.cy) / intrinsics.fy) +
+        world_R_camera.col(2);
+    for (int k = 0; k < 3; ++k) row_part[k * padded_height + v] = r[k];
   }
   std::atomic<uint64_t> cast{0};
   tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, tiles.size(), 32), [&](const tbb::blocked_range<size_t>& r) {
+      tbb::blocked_range<size_t>(0, tiles.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
         context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         uint64_t local_rays = 0;
         alignas(64) RTCRayHit16 packet;
         alignas(64) int valid[16];
+        HitPacket out;
+        // Lane constants: Embree writes only tfar and the hit.
+        for (int i = 0; i < 16; ++i) {
+          packet.ray.org_x[i] = origin.x();
+          packet.ray.org_y[i] = origin.y();
+          packet.ray.org_z[i] = origin.z();
+          packet.ray.tnear[i] = 0.0f;
+          packet.ray.time[i] = 0.0f;
+          packet.ray.mask[i] = 0xffffffffu;
+          packet.ray.id[i] = i;
+          packet.ray.flags[i] = 0;
+        }
+        alignas(64) float normal_x[16], normal_y[16], normal_z[16];
         for (size_t k = r.begin(); k != r.end(); ++k) {
           const int tile = tiles[k];
           const int u0 = (tile % tiles_x) * kTile;
           const int v0 = (tile / tiles_x) * kTile;
           const uint16_t mask = tile_mask[tile];
           for (int i = 0; i < 16; ++i) {
-            const int u = u0 + i % kTile;
-            const int v = v0 + i / kTile;
-            const bool on = (mask >> i) & 1u;
-            valid[i] = on ? -1 : 0;
-            const bool inside = u < width && v < height;
-            const Eigen::Vector3f dir = inside ? Eigen::Vector3f(column_part[u] + row_part[v])
-                                               : Eigen::Vector3f(row_part[0]);
-            packet.ray.org_x[i] = origin.x();
-            packet.ray.org_y[i] = origin.y();
-            packet.ray.org_z[i] = origin.z();
-            packet.ray.dir_x[i] = dir.x();
-            packet.ray.dir_y[i] = dir.y();
-            packet.ray.dir_z[i] = dir.z();
-            packet.ray.tnear[i] = 0.0f;
+            valid[i] = ((mask >> i) & 1u) ? -1 : 0;
             packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
-            if (on && moving_only) packet.ray.tfar[i] = hits->depth[v * width + u];
-            packet.ray.time[i] = 0.0f;
-            packet.ray.mask[i] = 0xffffffffu;
-            packet.ray.id[i] = i;
-            packet.ray.flags[i] = 0;
             packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
             packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-            local_rays += on;
           }
-          rtcIntersect16(valid, scene, &context, &packet);
-          for (int i = 0; i < 16; ++i) {
-            if (!valid[i]) continue;
-            const int u = u0 + i % kTile;
-            const int v = v0 + i / kTile;
-            const size_t p = static_cast<size_t>(v) * width + u;
-            if (packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
-              if (!moving_only) {
-                hits->depth[p] = std::numeric_limits<float>::infinity();
-                hits->object[p] = kNoObject;
-                hits->face[p] = 0;
-                hits->cos_incidence[p] = 0.0f;
+          TileDirections(&column_part[u0], &row_part[v0], packet.ray.dir_x);
+          TileDirections(&column_part[padded_width + u0], &row_part[padded_height + v0],
+                         packet.ray.dir_y);
+          TileDirections(&column_part[2 * padded_width + u0], &row_part[2 * padded_height + v0],
+                         packet.ray.dir_z);
+          if (moving_only) {
+            for (int i = 0; i < 16; ++i) {
+              if ((mask >> i) & 1u) {
+                packet.ray.tfar[i] =
+                    max_depth[static_cast<size_t>(v0 + i / kTile) * width + u0 + i % kTile];
               }
-              continue;
             }
-            uint32_t object = kNoObject;
-            if (instanced) object = instance_object[packet.hit.instID[0][i]];
-            if (object == kNoObject) object = s.static_geometry_object[packet.hit.geomID[i]];
-            Eigen::Vector3f normal(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]);
-            normal = world_R_object[object] * normal;
-            const Eigen::Vector3f dir(packet.ray.dir_x[i], packet.ray.dir_y[i],
-                                      packet.ray.dir_z[i]);
-            const float normal_norm = normal.norm();
-            const float norms = normal_norm * dir.norm();
-            const float dot = normal.dot(dir);
-            // Face the camera: the sensor sees the side the ray hits.
-            if (normal_norm > 0) normal *= (dot > 0 ? -1.0f : 1.0f) / normal_norm;
-            hits->normal[3 * p] = normal.x();
-            hits->normal[3 * p + 1] = normal.y();
-            hits->normal[3 * p + 2] = normal.z();
-            hits->depth[p] = packet.ray.tfar[i];
-            hits->object[p] = object;
-            hits->face[p] = packet.hit.primID[i];
-            hits->cos_incidence[p] = norms > 0 ? std::min(1.0f, std::abs(dot) / norms) : 0.0f;
           }
+          local_rays += std::popcount(static_cast<unsigned>(mask));
+          rtcIntersect16(valid, scene, &context, &packet);
+          out.u0 = u0;
+          out.v0 = v0;
+          out.cast = mask;
+          uint32_t hit = 0;
+          for (int i = 0; i < 16; ++i) {
+            const bool lane_hit = valid[i] && packet.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+            hit |= static_cast<uint32_t>(lane_hit) << i;
+          }
+          out.hit = hit;
+          const float* nx = packet.hit.Ng_x;
+          const float* ny = packet.hit.Ng_y;
+          const float* nz = packet.hit.Ng_z;
+          if (instanced) {
+            // Object-space normals of instances to world.
+            std::copy_n(packet.hit.Ng_x, 16, normal_x);
+            std::copy_n(packet.hit.Ng_y, 16, normal_y);
+            std::copy_n(packet.hit.Ng_z, 16, normal_z);
+            for (uint32_t bits = hit; bits != 0; bits &= bits - 1) {
+              const int i = std::countr_zero(bits);
+              uint32_t object = instance_object[packet.hit.instID[0][i]];
+              if (object == kNoObject) object = s.static_geometry_object[packet.hit.geomID[i]];
+              out.object[i] = object;
+              if (!s.objects[object].moving) continue;
+              const Eigen::Vector3f normal =
+                  world_R_object[object] *
+                  Eigen::Vector3f(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]);
+              normal_x[i] = normal.x();
+              normal_y[i] = normal.y();
+              normal_z[i] = normal.z();
+            }
+            nx = normal_x;
+            ny = normal_y;
+            nz = normal_z;
+          } else {
+            for (int i = 0; i < 16; ++i) {
+              out.object[i] =
+                  ((hit >> i) & 1u) ? s.static_geometry_object[packet.hit.geomID[i]] : kNoObject;
+            }
+          }
+          std::copy_n(packet.hit.primID, 16, out.face);
+          FinishLanes(nx, ny, nz, packet.ray.dir_x, packet.ray.dir_y, packet.ray.dir_z,
+                      packet.ray.tfar, &out);
+          sink->Consume(out);
         }
         cast.fetch_add(local_rays, std::memory_order_relaxed);
       });

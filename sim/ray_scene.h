@@ -42,6 +42,36 @@ struct HitBuffer {
   void Resize(int pixel_count);
 };
 
+// The hits of one 4x4 tile of pixels, structure of arrays (the renderer's write-back reads them
+// lane by lane without gathering). Lane i is pixel (u0 + i % 4, v0 + i / 4).
+struct HitPacket {
+  static constexpr int kTile = 4;
+  static constexpr int kLanes = kTile * kTile;
+  int u0 = 0;
+  int v0 = 0;
+  // Bit i: lane i was cast (its pixel lies in the spans).
+  uint32_t cast = 0;
+  // Bit i: lane i hit something (Target::kMoving: something nearer than its max_depth); only
+  // these lanes' fields below are set.
+  uint32_t hit = 0;
+  alignas(64) float depth[kLanes];  // along the optical axis [m]
+  alignas(64) uint32_t object[kLanes];
+  alignas(64) uint32_t face[kLanes];
+  // Unit world-frame surface normal facing the camera.
+  alignas(64) float normal_x[kLanes];
+  alignas(64) float normal_y[kLanes];
+  alignas(64) float normal_z[kLanes];
+  // Cosine of the angle between the viewing ray and the surface normal, in [0, 1].
+  alignas(64) float cos_incidence[kLanes];
+};
+
+// Receives the packets of a Cast; called concurrently from several threads, each packet once.
+class HitSink {
+ public:
+  virtual ~HitSink() = default;
+  virtual void Consume(const HitPacket& packet) = 0;
+};
+
 class RayScene {
  public:
   // Creates the Embree device. Embree errors are reported through its error callback and thrown
@@ -67,6 +97,8 @@ class RayScene {
   const std::string& object_name(uint32_t object) const;
   const TriangleMesh& object_mesh(uint32_t object) const;
   bool is_moving(uint32_t object) const;
+  // Pose of an object: static ones where they were placed, moving ones at their current pose.
+  const Rigid3& world_T_object(uint32_t object) const;
   // World bounds of a moving object at its current pose (empty when hidden).
   Bounds3 WorldBounds(uint32_t object) const;
 
@@ -79,6 +111,13 @@ class RayScene {
   enum class Target { kAll, kStatic, kMoving };
   void Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_camera,
             std::span<const PixelSpan> spans, Target target, HitBuffer* hits) const;
+
+  // The same rays handed to `sink` packet by packet (the caller keeps only what it needs). For
+  // kMoving, max_depth (#height by #width, row-major) bounds each ray: only nearer hits count;
+  // it may be null for kAll and kStatic (unbounded rays).
+  void Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_camera,
+            std::span<const PixelSpan> spans, Target target, const float* max_depth,
+            HitSink* sink) const;
 
   // Number of rays cast so far (for benchmarks).
   uint64_t rays_cast() const;

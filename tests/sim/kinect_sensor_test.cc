@@ -323,6 +323,35 @@ TEST(KinectSensor, FramesAreIndependentOfTheThreadCountAndFollowTheSeed) {
   EXPECT_NE(sensor.Render(8).depth, other_seed.depth);  // a new frame, new noise
 }
 
+TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
+  // Edges, shadows, grazing angles, a moving object and noise: every branch of the kernels.
+  RayScene scene;
+  scene.AddStatic("wall", Quad(10, 10), FacingCamera(1.4, -Eigen::Vector3d::UnitZ()));
+  scene.AddStatic("floor", Quad(3, 3),
+                  Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(1.45, Eigen::Vector3d::UnitX())),
+                         Eigen::Vector3d(0, 0.25, 1.2)));
+  const uint32_t a = scene.AddMoving("a", Box(0.1, 0.05, 0.08));
+  scene.SetPose(a, Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())),
+                          Eigen::Vector3d(0.03, -0.02, 0.8)));
+  scene.Commit();
+  for (bool quantise : {true, false}) {
+    KinectSensorOptions options;
+    options.quantise = quantise;
+    options.intrinsics.width = 333;  // rows that do not fill whole vectors
+    options.intrinsics.cx = 166;
+    KinectSensor vector_sensor(options, &scene, Rigid3::Identity());
+    KinectSensor portable_sensor(options, &scene, Rigid3::Identity());
+    const bool vector = KinectSensor::SetVectorKernels(true);
+    const RgbdFrame x = vector_sensor.Render(4);
+    KinectSensor::SetVectorKernels(false);
+    const RgbdFrame y = portable_sensor.Render(4);
+    KinectSensor::SetVectorKernels(true);
+    EXPECT_EQ(x.depth, y.depth) << "vector kernels in use: " << vector;
+    EXPECT_EQ(x.rgb, y.rgb);
+    EXPECT_GT(std::count(x.depth.begin(), x.depth.end(), 0), 100);
+  }
+}
+
 TEST(KinectSensor, RangeLimitsMakePixelsMissing) {
   RayScene scene;
   scene.AddStatic("far", Quad(40, 40), FacingCamera(4.5, -Eigen::Vector3d::UnitZ()));
