@@ -60,6 +60,8 @@ void RunRender(const CommonFlags& common, const std::vector<std::string>& argv) 
               << "written: " << out.string()
               << "/{rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt, camera.json, model.ply, "
                  "slider.csv, scene.json, render_summary.json, config.resolved.json, run.json"
+              << (render.render.story.empty() ? ""
+                                              : ", take.tum, take.csv, flaws.csv, participant.json")
               << (render.render.bop ? ", bop/" : "") << "}"
               << (render.render.fakenect ? " and " + out.string() + ".fakenect/" : "") << "\n";
   }

@@ -16,6 +16,8 @@
 #include "sim/bop_writer.h"
 #include "sim/duplo.h"
 #include "sim/fakenect_writer.h"
+#include "sim/random.h"
+#include "sim/story.h"
 
 namespace mmh::sim {
 namespace {
@@ -26,6 +28,12 @@ constexpr std::array<std::pair<RenderMode, const char*>, 2> kRenderModeNames = {
     {RenderMode::kIncremental, "incremental"},
     {RenderMode::kFull, "full"},
 }};
+constexpr std::array<std::pair<RenderSession, const char*>, 2> kRenderSessionNames = {{
+    {RenderSession::kRecording, "recording"},
+    {RenderSession::kAnnotation, "annotation"},
+}};
+// Where the proxy rests during an annotation session: on the table left of the play area.
+constexpr double kRestingProxyX = -0.32;
 
 Eigen::Quaterniond Yaw(double angle) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()));
@@ -42,6 +50,9 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
 
 std::span<const std::pair<RenderMode, const char*>> EnumNames(RenderMode) {
   return kRenderModeNames;
+}
+std::span<const std::pair<RenderSession, const char*>> EnumNames(RenderSession) {
+  return kRenderSessionNames;
 }
 
 void CameraPlacement::Validate(const std::string& prefix) const {
@@ -111,8 +122,22 @@ double DemoMotionOptions::SliderValue(double t) const {
 }
 
 void RenderOptions::Validate(const std::string& prefix) const {
-  if (frames < 1 || frames > 1000000) {
-    ThrowBadValue(prefix + ".frames", std::to_string(frames), "a frame count in [1, 1000000]");
+  if (frames < 0 || frames > 1000000) {
+    ThrowBadValue(prefix + ".frames", std::to_string(frames),
+                  "a frame count in [1, 1000000], or 0 for the whole take");
+  }
+  for (const auto& [value, name] :
+       {std::pair{animator, "animator"}, {take, "take"}, {object, "object"}}) {
+    if (value < 0 || value > 100000) {
+      ThrowBadValue(prefix + "." + name, std::to_string(value), "an index in [0, 100000]");
+    }
+  }
+  if (!story.empty() && !EndsWith(story, ".json")) {
+    ThrowBadValue(prefix + ".story", "\"" + story + "\"", "a story file (.json), or empty");
+  }
+  if (!story.empty() && !trajectory.empty()) {
+    ThrowBadValue(prefix + ".trajectory", "\"" + trajectory + "\"",
+                  "empty when render.story is given (the story's take is the motion)");
   }
   RequirePositive(proxy_scale, prefix + ".proxy_scale");
   if (!proxy.empty() && !EndsWith(proxy, ".json") && !EndsWith(proxy, ".obj") &&
@@ -123,7 +148,9 @@ void RenderOptions::Validate(const std::string& prefix) const {
 }
 
 RenderConfig RenderConfig::FromConfig(const Config& config) {
-  config.RequireOnlySections({"render", "camera", "scene", "hand", "sensor", "motion"});
+  config.RequireOnlySections({"render", "camera", "scene", "hand", "sensor", "motion", "population",
+                              "performance", "annotator", "viewer", "study", "scorers", "montage",
+                              "track", "metrics"});
   RenderConfig c;
   c.render = config.Get<RenderOptions>("render");
   c.camera = config.Get<CameraPlacement>("camera");
@@ -131,6 +158,9 @@ RenderConfig RenderConfig::FromConfig(const Config& config) {
   c.hand = config.Get<HandOptions>("hand");
   c.sensor = config.Get<KinectSensorOptions>("sensor");
   c.motion = config.Get<DemoMotionOptions>("motion");
+  c.population = config.Get<PopulationOptions>("population");
+  c.performance = config.Get<PerformanceOptions>("performance");
+  c.annotator = config.Get<AnnotatorOptions>("annotator");
   return c;
 }
 
@@ -142,6 +172,9 @@ nlohmann::json RenderConfig::ToJson() const {
   j["hand"] = mmh::ToJson(hand);
   j["sensor"] = mmh::ToJson(sensor);
   j["motion"] = mmh::ToJson(motion);
+  j["population"] = mmh::ToJson(population);
+  j["performance"] = mmh::ToJson(performance);
+  j["annotator"] = mmh::ToJson(annotator);
   return j;
 }
 
@@ -168,9 +201,16 @@ TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& pro
   SetFrame(Rigid3::Identity(), 0.0);  // a valid, committed scene from the start
 }
 
-void TableTopScene::SetFrame(const Rigid3& table_T_proxy, double slider_value) {
+void TableTopScene::SetFrame(const Rigid3& table_T_proxy, double slider_value, Hand hand) {
   scene_.SetPose(proxy_, table_T_proxy);
-  if (config_.render.hand) {
+  const Rigid3 table_T_slider =
+      LikeBoxSliderPose(config_.scene, std::clamp(slider_value, -5.0, 5.0));
+  if (config_.render.hand && hand == Hand::kOnSlider) {
+    // Pinching the block across its sides (fingers left, thumb right), the forearm reaching in
+    // from the right, so that the camera sees the block's front face as it slides.
+    scene_.SetPose(hand_, table_T_slider * Rigid3(Yaw(-std::numbers::pi / 2),
+                                                  Eigen::Vector3d(0, 0, kDuploBrickHeight)));
+  } else if (config_.render.hand) {
     // The hand holds the proxy from behind (+y, the animator's side): when the proxy has turned
     // its back to the animator, the hand grips it the other way round (a half turn about z).
     const Eigen::Vector3d x_axis = table_T_proxy.rotation * Eigen::Vector3d::UnitX();
@@ -180,7 +220,7 @@ void TableTopScene::SetFrame(const Rigid3& table_T_proxy, double slider_value) {
     scene_.SetPose(hand_, table_T_proxy * proxy_T_grip);
   }
   if (config_.render.slider) {
-    scene_.SetPose(slider_, LikeBoxSliderPose(config_.scene, std::clamp(slider_value, -5.0, 5.0)));
+    scene_.SetPose(slider_, table_T_slider);
   }
   scene_.Commit();
 }
@@ -192,6 +232,7 @@ nlohmann::json RenderSummary::ToJson() const {
   j["write_seconds"] = write_seconds;
   j["frames_per_second"] = seconds > 0 ? frames / seconds : 0.0;
   j["missing_fraction"] = missing_fraction;
+  if (!take.is_null()) j["take"] = take;
   j["rays"] = timings.rays;
   j["pixels_recast"] = timings.pixels_recast;
   j["seconds_per_step"] = {{"cast", timings.cast},
@@ -201,29 +242,153 @@ nlohmann::json RenderSummary::ToJson() const {
   return j;
 }
 
-RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
-                             const std::function<void(int, int)>& progress) {
+namespace {
+
+// The motion of a recording: per frame, the proxy's pose, the slider value and the hand.
+struct Motion {
+  int frames = 0;
+  std::string proxy;  // proxy model file ("" = the Soldier)
+  std::vector<Rigid3> table_T_proxy;
+  std::vector<double> slider;
+  TableTopScene::Hand hand = TableTopScene::Hand::kOnProxy;
+  // Story-driven recordings.
+  std::optional<Story> story;
+  std::optional<Participant> participant;
+  std::optional<PerformedTake> take;
+  std::optional<AnnotationSession> annotation;
+};
+
+// Resolves a story's proxy path: relative to the story file's folder.
+std::string StoryProxy(const std::string& story_file, const std::string& proxy) {
+  if (proxy.empty()) return "";
+  const std::filesystem::path path(proxy);
+  if (path.is_absolute()) return proxy;
+  return (std::filesystem::path(story_file).parent_path() / path).lexically_normal().string();
+}
+
+Motion ResolveMotion(const RenderConfig& config) {
   const RenderOptions& r = config.render;
-  // Read and check every input before the first frame.
-  const TriangleMesh proxy_model = LoadProxyModel(r.proxy, r.proxy_scale);
-  std::optional<Trajectory> trajectory;
-  if (!r.trajectory.empty()) {
-    trajectory = ReadTum(r.trajectory);
-    if (static_cast<int>(trajectory->size()) < r.frames) {
-      ThrowBadValue("render.trajectory (" + r.trajectory + ")",
-                    std::to_string(trajectory->size()) + " poses",
-                    "at least render.frames = " + std::to_string(r.frames));
+  Motion motion;
+  motion.proxy = r.proxy;
+  if (!r.story.empty()) {
+    motion.story = LoadStory(r.story, config.scene);
+    const Story& story = *motion.story;
+    if (r.object >= static_cast<int>(story.objects.size())) {
+      ThrowBadValue(
+          "render.object", std::to_string(r.object),
+          "an object of " + r.story + " (0.." + std::to_string(story.objects.size() - 1) + ")");
     }
+    motion.participant = DrawParticipant(config.population, r.animator);
+    const std::uint64_t seed = ParticipantSeed(config.population, r.animator);
+    motion.take = PerformTake(story, r.object, motion.participant->animator, r.take,
+                              config.performance, seed);
+    if (r.proxy.empty()) motion.proxy = StoryProxy(r.story, story.objects[r.object].proxy);
+    const int take_frames = motion.take->frames();
+    motion.frames = r.frames == 0 ? take_frames : std::min(r.frames, take_frames);
+    if (r.session == RenderSession::kRecording) {
+      motion.table_T_proxy = motion.take->table_T_proxy.poses;
+      motion.slider.assign(take_frames, config.annotator.start_value);
+    } else {
+      // The take plays on screen; the animator's hand is on the block; the proxy rests.
+      AnnotatorOptions annotator = config.annotator;
+      annotator.frame_rate = config.performance.frame_rate;
+      motion.annotation =
+          AnnotateTake(motion.take->quality.quality, motion.participant->annotator, annotator,
+                       DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(r.object),
+                                         static_cast<std::uint64_t>(r.take)}));
+      motion.slider = motion.annotation->slider;
+      motion.table_T_proxy.assign(take_frames, Rigid3(Eigen::Quaterniond::Identity(),
+                                                      Eigen::Vector3d(kRestingProxyX, 0, 0)));
+      motion.hand = TableTopScene::Hand::kOnSlider;
+    }
+    return motion;
+  }
+  std::optional<Trajectory> trajectory;
+  if (!r.trajectory.empty()) trajectory = ReadTum(r.trajectory);
+  motion.frames = r.frames != 0 ? r.frames
+                  : trajectory  ? static_cast<int>(trajectory->size())
+                                : 150;
+  if (trajectory && static_cast<int>(trajectory->size()) < motion.frames) {
+    ThrowBadValue("render.trajectory (" + r.trajectory + ")",
+                  std::to_string(trajectory->size()) + " poses",
+                  "at least render.frames = " + std::to_string(motion.frames));
   }
   std::optional<Annotation> annotation;
   if (!r.annotation.empty()) {
     annotation = ReadAnnotationCsv(r.annotation);
-    if (static_cast<int>(annotation->values.size()) < r.frames) {
+    if (static_cast<int>(annotation->values.size()) < motion.frames) {
       ThrowBadValue("render.annotation (" + r.annotation + ")",
                     std::to_string(annotation->values.size()) + " values",
-                    "at least render.frames = " + std::to_string(r.frames));
+                    "at least render.frames = " + std::to_string(motion.frames));
     }
   }
+  for (int i = 0; i < motion.frames; ++i) {
+    const double t = i / config.sensor.frame_rate;
+    motion.table_T_proxy.push_back(trajectory ? trajectory->poses[i]
+                                              : config.motion.TableTProxy(t));
+    motion.slider.push_back(annotation ? annotation->values[i] : config.motion.SliderValue(t));
+  }
+  return motion;
+}
+
+// take.csv, flaws.csv, take.tum and participant.json of a story-driven recording.
+void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
+                     const std::filesystem::path& out) {
+  const PerformedTake& take = *motion.take;
+  const StoryObject& object = motion.story->objects[take.object];
+  const double fps = config.performance.frame_rate;
+  std::string csv =
+      "frame,timestamp,beat,script_kind,performed_kind,progress,quality,fidelity,path,steadiness,"
+      "expression,motion";
+  if (motion.annotation) csv += ",judgement,delay,slider";
+  csv += "\n";
+  for (int i = 0; i < take.frames(); ++i) {
+    const QualityTrace& q = take.quality;
+    csv += std::to_string(i) + "," + FormatNumber(i / fps) + "," +
+           std::to_string(take.script_beat[i]) + "," +
+           BeatKindName(object.beats[take.script_beat[i]].kind) + "," +
+           BeatKindName(take.performed_kind[i]) + "," + FormatNumber(take.script_progress[i]) +
+           "," + FormatNumber(q.quality[i]) + "," + FormatNumber(q.fidelity[i]) + "," +
+           FormatNumber(q.path[i]) + "," + FormatNumber(q.steadiness[i]) + "," +
+           FormatNumber(q.expression[i]) + "," + FormatNumber(q.motion[i]);
+    if (motion.annotation) {
+      csv += "," + FormatNumber(motion.annotation->judgement[i]) + "," +
+             FormatNumber(motion.annotation->delay[i]) + "," +
+             FormatNumber(motion.annotation->slider[i]);
+    }
+    csv += "\n";
+  }
+  WriteFileAtomically(out / "take.csv", csv);
+  std::string flaws = "kind,beat,first_frame,last_frame\n";
+  for (const Flaw& f : take.flaws) {
+    flaws += std::string(EnumName(f.kind)) + "," + std::to_string(f.beat) + "," +
+             std::to_string(f.first_frame) + "," + std::to_string(f.last_frame) + "\n";
+  }
+  WriteFileAtomically(out / "flaws.csv", flaws);
+  WriteTum(out / "take.tum", take.table_T_proxy);
+  nlohmann::json participant;
+  participant["index"] = motion.participant->index;
+  participant["animator"] = {{"skill", motion.participant->animator.skill},
+                             {"energy", motion.participant->animator.energy},
+                             {"learning", motion.participant->animator.learning},
+                             {"bounce_style", motion.participant->animator.bounce_style},
+                             {"sway_style", motion.participant->animator.sway_style},
+                             {"yaw_style", motion.participant->animator.yaw_style},
+                             {"tempo_style", motion.participant->animator.tempo_style}};
+  participant["annotator"] = mmh::ToJson(motion.participant->annotator);
+  participant["take"] = take.take;
+  participant["skill_at_take"] = take.skill;
+  WriteFileAtomically(out / "participant.json", participant.dump(2) + "\n");
+}
+
+}  // namespace
+
+RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
+                             const std::function<void(int, int)>& progress) {
+  const RenderOptions& r = config.render;
+  // Read and check every input before the first frame.
+  const Motion motion = ResolveMotion(config);
+  const TriangleMesh proxy_model = LoadProxyModel(motion.proxy, r.proxy_scale);
   TableTopScene table_top(config, proxy_model);
   KinectSensor sensor(config.sensor, &table_top.scene(), table_top.table_T_camera());
   const Rigid3 depth_T_table = sensor.world_T_depth_camera().Inverse();
@@ -247,12 +412,11 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
   Annotation slider_truth;
   BopFrames bop;
   double missing_sum = 0.0;
-  for (int i = 0; i < r.frames; ++i) {
-    const double t = i / config.sensor.frame_rate;
-    const Rigid3 table_T_proxy = trajectory ? trajectory->poses[i] : config.motion.TableTProxy(t);
-    const double slider = annotation ? annotation->values[i] : config.motion.SliderValue(t);
+  for (int i = 0; i < motion.frames; ++i) {
+    const Rigid3& table_T_proxy = motion.table_T_proxy[i];
+    const double slider = motion.slider[i];
     const auto t0 = Clock::now();
-    table_top.SetFrame(table_T_proxy, slider);
+    table_top.SetFrame(table_T_proxy, slider, motion.hand);
     sensor.Render(i, r.mode, &frame);
     const auto t1 = Clock::now();
     writer.Add(frame);
@@ -270,10 +434,17 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
     bop.push_back({BopObjectPose{1, camera_T_proxy}});
     missing_sum += static_cast<double>(std::count(frame.depth.begin(), frame.depth.end(), 0)) /
                    frame.depth.size();
-    if (progress) progress(i + 1, r.frames);
+    if (progress) progress(i + 1, motion.frames);
   }
-  summary.frames = r.frames;
-  summary.missing_fraction = missing_sum / r.frames;
+  summary.frames = motion.frames;
+  summary.missing_fraction = missing_sum / motion.frames;
+  if (motion.take) {
+    summary.take = {{"frames", motion.take->frames()},
+                    {"mean_quality", motion.take->MeanQuality()},
+                    {"skill", motion.take->skill},
+                    {"flaws", motion.take->flaws.size()}};
+    if (motion.annotation) summary.take["clipped_fraction"] = motion.annotation->clipped_fraction;
+  }
   summary.timings = sensor.timings();
 
   // The setup's calibration, for the tracker: where the camera stands and where the Like box is.
@@ -292,6 +463,7 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
   WritePly(proxy_model, out / "model.ply");
   WriteAnnotationCsv(out / "slider.csv", slider_truth);
   WriteFileAtomically(out / "scene.json", scene_json.dump(2) + "\n");
+  if (motion.take) WriteStoryFiles(motion, config, out);
   if (fakenect) fakenect->Finish();
   if (r.bop) {
     EnsureDirectory(out / "bop" / "models");

@@ -2,9 +2,10 @@
 // the proxy and a slider track, rendered by the Kinect model into a TUM RGB-D folder (and,
 // optionally, a fakenect dump and BOP ground truth). `mmh render` is a thin layer over this.
 //
-// Until the scripted performances exist (sim/ performance issue), the proxy follows a TUM
-// trajectory file (table_T_proxy) or a built-in demo walk, and the slider an annotation CSV or a
-// built-in sweep.
+// The motion comes from a story performed by a simulated participant (render.story: a recording
+// session renders the take, an annotation session renders the participant annotating it with the
+// slider block while it plays), or from a TUM trajectory file (table_T_proxy) and an annotation
+// CSV, or from a built-in demo walk and slider sweep.
 #pragma once
 
 #include <filesystem>
@@ -20,11 +21,19 @@
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 #include "sim/kinect_sensor.h"
+#include "sim/population.h"
 #include "sim/props.h"
 
 namespace mmh::sim {
 
 std::span<const std::pair<RenderMode, const char*>> EnumNames(RenderMode);
+
+// What a story-driven recording shows (paper, "Recording a Take" and "Annotating the Takes").
+enum class RenderSession {
+  kRecording,   // the hand moves the proxy through the take; the slider block rests
+  kAnnotation,  // the take plays on screen; the hand moves the slider block; the proxy rests
+};
+std::span<const std::pair<RenderSession, const char*>> EnumNames(RenderSession);
 
 // The Kinect's placement in the table frame: at `position`, looking at `look_at`, its image x axis
 // horizontal (parallel to the table).
@@ -73,7 +82,8 @@ struct DemoMotionOptions {
 };
 
 struct RenderOptions {
-  int frames = 150;
+  // Frames to render; 0: the whole take (story), the whole trajectory file, or 150 (demo walk).
+  int frames = 0;
   RenderMode mode = RenderMode::kIncremental;
   // The proxy: a Duplo assembly (.json, see configs/proxies/) or a mesh (.obj, .ply) scaled by
   // proxy_scale (e.g. 0.001 for millimetres). Empty: the Soldier figure.
@@ -85,6 +95,13 @@ struct RenderOptions {
   std::string annotation;
   bool hand = true;
   bool slider = true;
+  // A story (configs/stories/*.json) performed by participant `animator` of the population:
+  // take `take` of object `object`, recorded or annotated. Empty: trajectory / demo walk.
+  std::string story;
+  int animator = 0;
+  int take = 0;
+  int object = 0;
+  RenderSession session = RenderSession::kRecording;
   // Outputs besides the TUM RGB-D folder.
   bool fakenect = false;
   bool bop = false;
@@ -99,6 +116,11 @@ struct RenderOptions {
     v("annotation", annotation);
     v("hand", hand);
     v("slider", slider);
+    v("story", story);
+    v("animator", animator);
+    v("take", take);
+    v("object", object);
+    v("session", session);
     v("fakenect", fakenect);
     v("bop", bop);
   }
@@ -113,7 +135,12 @@ struct RenderConfig {
   HandOptions hand;
   KinectSensorOptions sensor;
   DemoMotionOptions motion;
+  PopulationOptions population;
+  PerformanceOptions performance;
+  AnnotatorOptions annotator;
 
+  // Reads the render sections; the other sections of a study config (study, montage, track,
+  // metrics, viewer, scorers) may be present and are left to the commands that use them.
   static RenderConfig FromConfig(const Config& config);
   nlohmann::json ToJson() const;
 };
@@ -125,8 +152,9 @@ TriangleMesh LoadProxyModel(const std::string& proxy, double scale);
 class TableTopScene {
  public:
   TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model);
-  // Places the proxy (and the hand holding it) and the slider block; commits the scene.
-  void SetFrame(const Rigid3& table_T_proxy, double slider_value);
+  enum class Hand { kOnProxy, kOnSlider };
+  // Places the proxy, the slider block and the hand holding one of them; commits the scene.
+  void SetFrame(const Rigid3& table_T_proxy, double slider_value, Hand hand = Hand::kOnProxy);
   const RayScene& scene() const { return scene_; }
   const Rigid3& table_T_camera() const { return table_T_camera_; }
 
@@ -144,14 +172,19 @@ struct RenderSummary {
   double write_seconds = 0.0;     // encoding and writing
   double missing_fraction = 0.0;  // mean over frames
   SensorTimings timings;
+  // Story-driven recordings: the take's length, mean latent quality and flaws.
+  nlohmann::json take;
   nlohmann::json ToJson() const;
 };
 
 // Renders the sequence and writes `out` (a TUM RGB-D folder: rgb/, depth/, rgb.txt, depth.txt,
 // groundtruth.txt = camera_T_proxy of the depth camera, camera.json), plus model.ply (the proxy's
 // model for the tracker, metres), slider.csv (the true slider values), scene.json (camera_T_table,
-// play area and Like box: the setup's calibration), fakenect/ and bop/ when enabled. Everything is
-// read and checked before the first frame; folders appear complete or not at all.
+// play area and Like box: the setup's calibration), fakenect/ and bop/ when enabled. A story adds
+// take.tum (table_T_proxy of the whole take), take.csv (per frame: beat, performed action, latent
+// quality and its factors; annotation sessions also the judgement, delay and slider), flaws.csv and
+// participant.json. Everything is read and checked before the first frame; folders appear
+// complete or not at all.
 RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
                              const std::function<void(int, int)>& progress = {});
 

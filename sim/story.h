@@ -9,7 +9,7 @@
 //     "objects": [
 //       {
 //         "name": "soldier",
-//         "proxy": "configs/proxies/soldier.json",           (relative to the repository root)
+//         "proxy": "../proxies/soldier.json",                (relative to the story file)
 //         "height": 0.08,                                     [m] top of the figure above its base
 //         "path": [[x, y], ...],                              [m] waypoints, table frame
 //         "start": 0,                                         waypoint the object starts at

@@ -83,6 +83,51 @@ TEST_F(RenderCliTest, BadInputExitsWithTwoNamingTheKeyAndWritesNothing) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
+TEST_F(RenderCliTest, RendersAParticipantsTakeAndItsAnnotationSession) {
+  const std::string study = std::string(MMH_SOURCE_DIR) + "/configs/study_soldier.json";
+  const std::string story = std::string(MMH_SOURCE_DIR) + "/configs/stories/soldier.json";
+  const std::string args =
+      " --config " + study + " --set render.story=\\\"" + story +
+      "\\\" --set render.animator=2 --set render.take=1 --set render.frames=3 --quiet";
+  auto r = RunMmh("render --out " + (dir_ / "rec").string() + args);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = RunMmh("render --out " + (dir_ / "ann").string() + args + " --set render.session=annotation");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* file : {"take.tum", "take.csv", "flaws.csv", "participant.json"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "rec" / file)) << file;
+  }
+  // The same participant's same take in both sessions; the whole take is described even when
+  // only its first frames are rendered.
+  EXPECT_EQ(ReadBytes(dir_ / "rec" / "take.tum"), ReadBytes(dir_ / "ann" / "take.tum"));
+  EXPECT_GT(ReadTum(dir_ / "rec" / "take.tum").size(), 1500u);
+  EXPECT_EQ(ReadTum(dir_ / "rec" / "groundtruth.txt").size(), 3u);
+  // The rendered slider is the annotator's hand, as take.csv reports it.
+  std::istringstream take(ReadBytes(dir_ / "ann" / "take.csv"));
+  std::string header, row;
+  std::getline(take, header);
+  EXPECT_THAT(header, HasSubstr(",judgement,delay,slider"));
+  std::istringstream slider(ReadBytes(dir_ / "ann" / "slider.csv"));
+  std::string slider_row;
+  std::getline(slider, slider_row);
+  for (int i = 0; i < 3; ++i) {
+    std::getline(take, row);
+    std::getline(slider, slider_row);
+    const double from_take = std::stod(row.substr(row.rfind(',') + 1));
+    const double rendered = std::stod(slider_row.substr(slider_row.find(',') + 1));
+    EXPECT_NEAR(from_take, rendered, 1e-9) << i;
+  }
+  // A broken story names its file and beat; nothing is written.
+  test_util::WriteText(
+      dir_ / "bad.json",
+      R"({"name": "b", "objects": [{"name": "a", "path": [[0, 0], [0.1, 0]], "end": 5,
+                           "beats": [{"kind": "walk", "start": 0, "to": 1}, {"kind": "skip", "start": 2}]}]})");
+  r = RunMmh("render --out " + (dir_ / "bad").string() + " --set render.story=\\\"" +
+             (dir_ / "bad.json").string() + "\\\" --quiet");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("bad.json: objects[0].beats[1].kind"));
+  EXPECT_FALSE(fs::exists(dir_ / "bad"));
+}
+
 TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   if (!fs::exists(fs::path(MMH_SOURCE_DIR) / "../shared/data/real-rgbd/TUM_depth.png") &&
       !fs::exists("/work/shared/data/real-rgbd/TUM_depth.png")) {
