@@ -1,0 +1,152 @@
+// `mmh track`: the tracker on a frame source (a TUM RGB-D folder, or a Kinect v1 through
+// libfreenect); writes trajectory.tum, status.csv, annotation.csv, track_summary.json,
+// config.resolved.json and run.json (docs/tracker.md).
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+#include "cli/command_registry.h"
+#include "cli/compose_command.h"
+#include "cli/provenance.h"
+#include "core/atomic_file.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "core/mesh_io.h"
+#include "track/frame_source.h"
+#include "track/freenect_source.h"
+#include "track/track_session.h"
+
+namespace mmh::cli {
+namespace {
+
+struct TrackArgs {
+  CommonFlags common;
+  std::string input;
+  std::string model;
+  std::string setup;
+};
+
+void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
+  namespace fs = std::filesystem;
+  Config config;
+  if (!args.common.config_file.empty()) config = Config::Load(args.common.config_file);
+  for (const auto& set : args.common.sets) config.Set(set);
+  const track::TrackConfig track_config = track::TrackConfig::FromConfig(config);
+  std::unique_ptr<tbb::global_control> threads;
+  if (args.common.threads > 0) {
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    args.common.threads);
+  }
+
+  // Everything is read and checked before the first frame.
+  const TriangleMesh model = LoadMesh(args.model, track_config.run.model_scale);
+  const bool live = args.input == "freenect";
+  if (!live && !fs::is_directory(args.input)) {
+    ThrowBadValue("--input", "\"" + args.input + "\"",
+                  "a TUM RGB-D folder or 'freenect' (a Kinect v1 through libfreenect)");
+  }
+  track::TrackSetup setup;
+  bool calibrated = false;
+  std::string setup_file = args.setup;
+  if (setup_file.empty() && !live && fs::exists(fs::path(args.input) / "scene.json")) {
+    setup_file = (fs::path(args.input) / "scene.json").string();
+  }
+  if (!setup_file.empty()) {
+    setup = track::ReadSetupJson(setup_file);
+    calibrated = true;
+  }
+  std::unique_ptr<track::FrameSource> source;
+  if (live) {
+    source = std::make_unique<track::FreenectFrameSource>(track_config.freenect);
+  } else {
+    source = std::make_unique<track::FolderFrameSource>(
+        args.input, track_config.run.override_intrinsics
+                        ? std::optional<PinholeIntrinsics>(track_config.run.intrinsics)
+                        : std::nullopt);
+  }
+
+  const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
+  const track::TrackRun run = track::RunTracking(*source, model, args.model, setup, calibrated,
+                                                 track_config, [&](int done, int total) {
+                                                   if (bar && done % 10 == 0) {
+                                                     std::cerr << "\rtrack: " << done;
+                                                     if (total > 0) std::cerr << " / " << total;
+                                                     std::cerr << " frames" << std::flush;
+                                                   }
+                                                 });
+  if (bar) std::cerr << '\n';
+
+  const fs::path out = args.common.out_dir;
+  std::vector<std::string> written = track::WriteTrackRun(out, run, track_config);
+  const nlohmann::json resolved = track_config.ToJson();
+  nlohmann::json timings = run.summary.ToJson();
+  timings["input"] = source->Describe();
+  timings["setup"] =
+      setup_file.empty() ? "none (table frame from the estimated plane)" : setup_file;
+  WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
+  WriteFileAtomically(out / "run.json",
+                      Provenance(argv, resolved, args.common.threads, timings).dump(2) + "\n");
+  written.push_back("config.resolved.json");
+  written.push_back("run.json");
+  if (!args.common.quiet) {
+    const track::TrackSummary& s = run.summary;
+    std::cout << "track: " << s.frames << " frames from " << source->Describe() << ": " << s.tracked
+              << " tracked, " << s.predicted << " predicted, " << s.lost << " lost ("
+              << s.detections << " detections)";
+    if (!run.slider.empty()) std::cout << "; slider found in " << s.slider_found;
+    std::cout << "; " << (s.seconds > 0 ? s.frames / s.seconds : 0.0) << " frames/s\n";
+    if (!calibrated) {
+      std::cout << "note: no setup calibration (--setup or scene.json): table frame from the "
+                   "estimated plane, slider not read\n";
+    }
+    std::cout << "written: " << out.string() << "/{";
+    for (size_t i = 0; i < written.size(); ++i) std::cout << (i ? ", " : "") << written[i];
+    std::cout << "}\n";
+  }
+  if (run.summary.frames == 0) {
+    throw InputError("--input " + args.input + ": the source delivered no frame");
+  }
+  if (run.summary.tracked == 0) {
+    // A failure of the work, not of the input's form: every frame was lost (status.csv says why).
+    throw std::runtime_error("no frame was tracked (a model that does not match the proxy?); see " +
+                             (out / "status.csv").string());
+  }
+}
+
+}  // namespace
+
+void AddTrackCommand(CLI::App& app, const std::vector<std::string>& argv) {
+  auto args = std::make_shared<TrackArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "track",
+      "Tracker on a frame source: proxy trajectory (TUM), per-frame status, slider "
+      "annotation (CSV)");
+  cmd->add_option("--input", args->input,
+                  "A TUM RGB-D folder (ours or a public sequence), or 'freenect' for a Kinect v1")
+      ->required();
+  cmd->add_option("--model", args->model,
+                  "The proxy's mesh (.ply or .obj), e.g. model.ply of a "
+                  "rendered take")
+      ->required();
+  cmd->add_option("--setup", args->setup,
+                  "Setup calibration (scene.json keys: camera_T_table, table.play_area_*, "
+                  "table.like_box_*); default: INPUT/scene.json when present");
+  cmd->add_option("--config", args->common.config_file,
+                  "JSON config: sections run, tracker, slider, freenect");
+  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
+      ->take_all();
+  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
+  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  cmd->callback([args, argv] { RunTrack(*args, argv); });
+}
+
+MMH_REGISTER_COMMAND(40, AddTrackCommand);
+
+}  // namespace mmh::cli

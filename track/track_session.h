@@ -1,0 +1,105 @@
+// One tracking run over a frame source, as `mmh track` does it: the proxy tracker and the slider
+// reader on every frame, collected into the outputs (trajectory.tum, status.csv, annotation.csv,
+// track_summary.json).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/annotation.h"
+#include "core/config.h"
+#include "core/trajectory.h"
+#include "core/triangle_mesh.h"
+#include "track/frame_source.h"
+#include "track/freenect_source.h"
+#include "track/proxy_tracker.h"
+#include "track/setup.h"
+#include "track/slider_reader.h"
+
+namespace mmh::track {
+
+// Frame of the written trajectory: camera_T_proxy (the depth camera's frame, as groundtruth.txt
+// of a rendered take) or table_T_proxy (the estimated table frame).
+enum class OutputFrame { kCamera, kTable };
+std::span<const std::pair<OutputFrame, const char*>> EnumNames(OutputFrame);
+
+struct TrackRunOptions {
+  OutputFrame output_frame = OutputFrame::kCamera;
+  // The model file's unit [m per unit] (0.001 for a model in millimetres).
+  double model_scale = 1.0;
+  // Read the slider (needs a setup calibration with a Like box).
+  bool slider = true;
+  // Intrinsics for a TUM-layout folder without camera.json and without 'freiburg1/2/3' in its
+  // name (used only when override_intrinsics is true, then for any folder).
+  bool override_intrinsics = false;
+  PinholeIntrinsics intrinsics;
+  // Stop after this many frames (0: all).
+  int max_frames = 0;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("output_frame", output_frame);
+    v("model_scale", model_scale);
+    v("slider", slider);
+    v("override_intrinsics", override_intrinsics);
+    v("intrinsics", intrinsics);
+    v("max_frames", max_frames);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+// Every section of a track config: "run", "tracker", "slider", "freenect".
+struct TrackConfig {
+  TrackRunOptions run;
+  ProxyTrackerOptions tracker;
+  SliderReaderOptions slider;
+  FreenectOptions freenect;
+
+  static TrackConfig FromConfig(const Config& config);
+  nlohmann::json ToJson() const;
+};
+
+struct TrackSummary {
+  int frames = 0;
+  int tracked = 0;
+  int predicted = 0;
+  int lost = 0;
+  int detections = 0;  // frames whose pose came from the global detection
+  int slider_found = 0;
+  double seconds = 0.0;  // tracking and slider reading, reading frames excluded
+  nlohmann::json ToJson() const;
+};
+
+struct TrackRun {
+  std::vector<TrackFrameResult> frames;
+  std::vector<SliderReading> slider;  // empty without slider reading
+  // The poses of the frames not lost, in the output frame.
+  Trajectory trajectory;
+  // One value per frame: the reading, or the last one before it (0 before the first) where the
+  // block was not found.
+  Annotation annotation;
+  std::optional<Rigid3> camera_T_table;
+  std::optional<TablePlane> table_plane;
+  TrackSummary summary;
+};
+
+// Tracks every frame of `source` (progress(done, total or -1) after each). The setup is the
+// calibration (track/setup.h); slider reading needs one with a Like box and setup_calibrated
+// (without a calibration the table frame is the estimated one, where the Like box is unknown).
+TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::string& model_name,
+                     const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
+                     const std::function<void(int, int)>& progress = {});
+
+// Writes status.csv, annotation.csv (when the slider was read), trajectory.tum (when any frame
+// was not lost) and track_summary.json into `out` (created), each atomically. Returns the names
+// written.
+std::vector<std::string> WriteTrackRun(const std::filesystem::path& out, const TrackRun& run,
+                                       const TrackConfig& config);
+
+}  // namespace mmh::track
