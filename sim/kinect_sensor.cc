@@ -8,7 +8,6 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <boost/math/distributions/normal.hpp>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -43,40 +42,6 @@ inline uint64_t Mix64(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
-}
-
-// Standard normal quantiles at the midpoints (i + 0.5) / 2^16, rescaled to unit variance: a
-// 16-bit uniform indexes an exactly symmetric, unit-variance normal sample (tails to 4.3 sigma).
-// Standard normal quantiles at the midpoints (i + 0.5) / 2^bits, rescaled to unit variance: a
-// `bits`-bit uniform indexes an exactly symmetric, unit-variance normal sample.
-std::vector<float> NormalQuantileTable(int bits) {
-  const int size = 1 << bits;
-  std::vector<double> q(size);
-  boost::math::normal_distribution<double> normal;
-  double sum_sq = 0.0;
-  for (int i = 0; i < size / 2; ++i) {
-    const double x = boost::math::quantile(normal, (i + 0.5) / size);
-    q[i] = x;
-    q[size - 1 - i] = -x;
-    sum_sq += 2 * x * x;
-  }
-  const double scale = 1.0 / std::sqrt(sum_sq / size);
-  std::vector<float> out(size);
-  for (int i = 0; i < size; ++i) out[i] = static_cast<float>(q[i] * scale);
-  return out;
-}
-
-// Depth noise: 2^16 entries (tails to 4.3 sigma).
-const std::vector<float>& GaussTable() {
-  static const std::vector<float> table = NormalQuantileTable(16);
-  return table;
-}
-
-// Colour noise: 2^12 entries; 8-bit output makes finer quantiles pointless, and the 16 KB table
-// stays in the L1 cache.
-const std::vector<float>& SmallGaussTable() {
-  static const std::vector<float> table = NormalQuantileTable(12);
-  return table;
 }
 
 // Tables indexed by the incidence cosine quantised to kCosSteps.
@@ -121,8 +86,7 @@ std::vector<PixelSpan> SpansOfRects(const std::vector<Rect>& rects, int height) 
 
 // Everything the per-pixel depth model needs, as floats for the vector loops.
 struct DepthParams {
-  uint32_t key_a = 0, key_b = 0;
-  const float* gauss = nullptr;
+  uint32_t key_a = 0, key_b = 0, key_c = 0;
   bool noise = true;
   bool quantise = true;
   float lattice = 0, raw_offset = 0;
@@ -133,6 +97,12 @@ struct DepthParams {
   const float* lateral_cross = nullptr;  // per cos step: P(the lateral offset crosses the edge)
   const float* drop = nullptr;           // per cos step: P(grazing or speckle dropout)
   const float* grazing_sigma = nullptr;  // per cos step: grazing term of sigma_z times sqrt(z)
+};
+
+// Colour noise: sigma^2 = read2 + gain * value.
+struct ColorParams {
+  uint32_t key = 0;
+  float read2 = 0, gain = 0;
 };
 
 // Chris Wellons' lowbias32: a bijective 32-bit mix with low bias. Keyed per frame and noise
@@ -150,24 +120,71 @@ inline uint32_t CounterHash(uint32_t key, uint32_t counter) {
   return Mix32((counter * 0x9E3779B9u) ^ key);
 }
 
+// Box-Muller (1958) from a 32-bit hash: radius sqrt(-2 ln u1) with u1 = (bits 16-31 + 1/2) / 2^16
+// (tails to 4.85 sigma), angle q pi/2 + x with the quadrant q = bits 14-15 and x uniform in
+// (-pi/4, pi/4) from bits 0-13. Returns the two independent standard normals r cos and r sin.
+// ln, sin and cos are evaluated here with IEEE operations only (no libm, whose vector variants
+// may round differently): ln m = 2 atanh((m - 1) / (m + 1)) on m in [sqrt(1/2), sqrt(2)) (series
+// to s^9, error < 1e-9), sin and cos by their Taylor series to x^9 and x^10 on |x| <= pi/4
+// (error < 3e-10). The AVX-512 kernels repeat these operations in the same order.
+constexpr float kLn2 = 0.693147180559945309f;
+constexpr float kSqrtHalf = 0.707106781186547524f;
+constexpr float kSqrt2 = 1.41421356237309505f;
+constexpr float kHalfPi = 1.57079632679489662f;
+
+inline float LnUnit(float u) {
+  const auto bits = std::bit_cast<uint32_t>(u);
+  int e = static_cast<int>(bits >> 23) - 127;
+  float m = std::bit_cast<float>((bits & 0x007fffffu) | 0x3f800000u);
+  const bool high = m >= kSqrt2;
+  m = high ? m * 0.5f : m;
+  e = high ? e + 1 : e;
+  const float s = (m - 1.0f) / (m + 1.0f);
+  const float s2 = s * s;
+  const float series = 1.0f + s2 * (1.0f / 3 + s2 * (1.0f / 5 + s2 * (1.0f / 7 + s2 * (1.0f / 9))));
+  return static_cast<float>(e) * kLn2 + 2.0f * s * series;
+}
+
+inline void BoxMuller(uint32_t h, float* c, float* s) {
+  const float u1 = (static_cast<float>(static_cast<int>(h >> 16)) + 0.5f) * (1.0f / 65536.0f);
+  const float r = std::sqrt(-2.0f * LnUnit(u1));
+  const uint32_t q = (h >> 14) & 3u;
+  const float t = (static_cast<float>(static_cast<int>(h & 0x3fffu)) + 0.5f) * (1.0f / 16384.0f);
+  const float x = (t - 0.5f) * kHalfPi;
+  const float x2 = x * x;
+  const float sin_x =
+      x + x * x2 * (-1.0f / 6 + x2 * (1.0f / 120 + x2 * (-1.0f / 5040 + x2 * (1.0f / 362880))));
+  const float cos_x =
+      1.0f +
+      x2 * (-1.0f / 2 +
+            x2 * (1.0f / 24 + x2 * (-1.0f / 720 + x2 * (1.0f / 40320 + x2 * (-1.0f / 3628800)))));
+  // (cos, sin) of q pi/2 + x.
+  const float a = (q & 1u) ? sin_x : cos_x;
+  const float b = (q & 1u) ? cos_x : sin_x;
+  const float cos_angle = ((q == 1u) | (q == 2u)) ? -a : a;
+  const float sin_angle = (q >= 2u) ? -b : b;
+  *c = r * cos_angle;
+  *s = r * sin_angle;
+}
+
 inline int CosStep(float cos_incidence) {
   const int step = static_cast<int>(cos_incidence * static_cast<float>(kCosSteps));
   return step < kCosSteps ? step : kCosSteps;
 }
 
-// One pixel of the depth model after the lateral step: axial noise, the disparity lattice, range
-// and random dropouts. h: bits 0-15 the dropout uniform, 16-31 the normal sample. The vector loop
-// and the scalar edge pass both call it: IEEE operations only, so both round alike.
+// One pixel of the depth model after the lateral step: axial noise (g: a standard normal), the
+// disparity lattice, range and random dropouts (h: bits 0-15 the dropout uniform). The vector
+// loop and the scalar edge pass both call it: IEEE operations only, so both round alike.
 template <bool kQuantise>
 inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, bool keep,
-                            uint32_t h) {
+                            uint32_t h, float g) {
   const int step = CosStep(cos_incidence);
   const float u_drop = static_cast<float>(static_cast<int>(h & 0xffffu)) * (1.0f / 65536.0f);
   // Pixels that see nothing get a harmless depth so that the arithmetic stays finite.
   z = keep ? z : 1.0f;
   const float dz = z - q.axial_z0;
   const float sigma = q.axial_a + q.axial_b * dz * dz + q.grazing_sigma[step] / std::sqrt(z);
-  const float zn = z + sigma * q.gauss[h >> 16];
+  const float zn = z + sigma * g;
   const float raw = std::floor(q.raw_offset - q.lattice / zn + 0.5f);
   const float zq = q.lattice / (q.raw_offset - raw);
   // Selections written so that GCC if-converts them (the loop must vectorise).
@@ -183,12 +200,12 @@ inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, 
 }
 
 // One pixel of the depth row's vector part: whether it is kept (something hit, not occluded) and
-// an edge (largest 4-neighbour disparity difference above edge_jump), its noise hash, and its
-// sample as if it were no edge.
+// an edge (largest 4-neighbour disparity difference above edge_jump), its dropout hash (key_b)
+// and normal sample (Box-Muller of the key_c hash), and its sample as if it were no edge.
 template <bool kQuantise>
 inline uint16_t DepthPixel(const DepthParams& q, float left, float d, float right, float up,
                            float down, float depth, float cos_incidence, uint8_t occluded,
-                           uint32_t counter, uint8_t* edge, uint32_t* hash) {
+                           uint32_t counter, uint8_t* edge, uint32_t* hash, float* normal) {
   const float jump = std::max(std::max(std::abs(d - left), std::abs(d - right)),
                               std::max(std::abs(d - up), std::abs(d - down)));
   // Disparity 0: nothing hit.
@@ -196,59 +213,58 @@ inline uint16_t DepthPixel(const DepthParams& q, float left, float d, float righ
   *edge = static_cast<uint8_t>(keep & (jump > q.edge_jump));
   const uint32_t h = CounterHash(q.key_b, counter);
   *hash = h;
-  return DepthSample<kQuantise>(q, depth, cos_incidence, keep, h);
+  float g, unused;
+  BoxMuller(CounterHash(q.key_c, counter), &g, &unused);
+  *normal = g;
+  return DepthSample<kQuantise>(q, depth, cos_incidence, keep, h, g);
 }
 
 // A row of DepthPixel (n >= 2; outside the image counts as equal: no jump).
 template <bool kQuantise>
-MMH_SIMD_CLONES void DepthRowKernel(const DepthParams& params, const float* __restrict up,
-                                    const float* __restrict row, const float* __restrict down,
-                                    const float* __restrict depth,
-                                    const float* __restrict cos_incidence,
-                                    const uint8_t* __restrict occluded, uint32_t first_pixel, int n,
-                                    uint8_t* __restrict edge, uint32_t* __restrict hash,
-                                    uint16_t* __restrict out) {
-  const DepthParams q = params;
-  out[0] = DepthPixel<kQuantise>(q, row[0], row[0], row[1], up[0], down[0], depth[0],
-                                 cos_incidence[0], occluded[0], first_pixel, &edge[0], &hash[0]);
-  for (int i = 1; i + 1 < n; ++i) {
-    out[i] = DepthPixel<kQuantise>(q, row[i - 1], row[i], row[i + 1], up[i], down[i], depth[i],
-                                   cos_incidence[i], occluded[i],
-                                   first_pixel + static_cast<uint32_t>(i), &edge[i], &hash[i]);
-  }
-  const int l = n - 1;
-  out[l] = DepthPixel<kQuantise>(q, row[l - 1], row[l], row[l], up[l], down[l], depth[l],
-                                 cos_incidence[l], occluded[l],
-                                 first_pixel + static_cast<uint32_t>(l), &edge[l], &hash[l]);
-}
-
-// Colour noise on n bytes (RGB interleaved): sigma^2 = read^2 + gain * value per channel, one
-// 12-bit normal index per byte from 16-bit halves of counter hashes.
-MMH_SIMD_CLONES void ColorRowKernel(const uint8_t* __restrict in, uint32_t key,
-                                    uint32_t first_counter, int n, const float* __restrict sigma,
-                                    const float* __restrict gauss, uint16_t* __restrict index,
-                                    uint8_t* __restrict out) {
-  const int pairs = (n + 1) / 2;
-  for (int k = 0; k < pairs; ++k) {
-    const uint32_t h = CounterHash(key, first_counter + static_cast<uint32_t>(k));
-    index[2 * k] = static_cast<uint16_t>(h & 0xfffu);
-    index[2 * k + 1] = static_cast<uint16_t>((h >> 16) & 0xfffu);
-  }
-  for (int j = 0; j < n; ++j) {
-    const uint8_t value = in[j];
-    float noisy = static_cast<float>(value) + sigma[value] * gauss[index[j]];
-    noisy = std::floor(noisy + 0.5f);
-    noisy = noisy < 0.0f ? 0.0f : (noisy > 255.0f ? 255.0f : noisy);
-    out[j] = static_cast<uint8_t>(static_cast<int>(noisy));
+void DepthRowPortable(const DepthParams& q, const float* up, const float* row, const float* down,
+                      const float* depth, const float* cos_incidence, const uint8_t* occluded,
+                      uint32_t first_pixel, int n, uint8_t* edge, uint32_t* hash, float* normal,
+                      uint16_t* out) {
+  for (int i = 0; i < n; ++i) {
+    const float left = i > 0 ? row[i - 1] : row[i];
+    const float right = i + 1 < n ? row[i + 1] : row[i];
+    out[i] = DepthPixel<kQuantise>(
+        q, left, row[i], right, up[i], down[i], depth[i], cos_incidence[i], occluded[i],
+        first_pixel + static_cast<uint32_t>(i), &edge[i], &hash[i], &normal[i]);
   }
 }
 
-// Hand-vectorised AVX-512 kernels: GCC 12 does not vectorise these loops well (no gathers at
-// generic tuning, floor only with -fno-trapping-math). They mirror the portable kernels above
-// operation by operation (the same IEEE additions, multiplications, divisions, square roots,
-// floors and comparisons, in the same order; gathers load what the scalar code indexes), so
-// frames do not depend on which of them runs (tested).
+// One colour byte: value + sigma g, rounded and clamped.
+inline uint8_t NoisyColor(const ColorParams& p, uint8_t value, float g) {
+  const float v = static_cast<float>(value);
+  const float sigma = std::sqrt(p.read2 + p.gain * v);
+  float noisy = std::floor(v + sigma * g + 0.5f);
+  noisy = noisy > 255.0f ? 255.0f : noisy;
+  noisy = noisy < 0.0f ? 0.0f : noisy;
+  return static_cast<uint8_t>(static_cast<int>(noisy));
+}
+
+// Colour noise on n bytes (RGB interleaved) of a row: bytes 2k and 2k + 1 take the two normals of
+// the Box-Muller pair of counter first_counter + k.
+void ColorRowPortable(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
+                      uint8_t* out) {
+  for (int k = 0; 2 * k < n; ++k) {
+    float c, s;
+    BoxMuller(CounterHash(p.key, first_counter + static_cast<uint32_t>(k)), &c, &s);
+    out[2 * k] = NoisyColor(p, in[2 * k], c);
+    if (2 * k + 1 < n) out[2 * k + 1] = NoisyColor(p, in[2 * k + 1], s);
+  }
+}
+
+// Hand-vectorised AVX-512 kernels (GCC 12 vectorises neither the bit manipulation nor floor
+// well). They mirror the portable kernels above operation by operation (the same IEEE
+// additions, multiplications, divisions, square roots, floors, comparisons and selections, in
+// the same order; gathers load what the scalar code indexes), so frames do not depend on which
+// of them runs (tested).
 #if MMH_SENSOR_AVX512
+// GCC 12's intrinsics headers trip -Wmaybe-uninitialized on their own undefined-vector helpers.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #define MMH_AVX512 __attribute__((target("avx512f,avx512bw,avx512dq,avx512vl")))
 
 MMH_AVX512 inline __m512i Mix32x16(__m512i x) {
@@ -272,29 +288,77 @@ MMH_AVX512 inline __m512 Floorx16(__m512 x) {
   return _mm512_roundscale_ps(x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
 }
 MMH_AVX512 inline __m512 AbsDiff(__m512 a, __m512 b) { return _mm512_abs_ps(_mm512_sub_ps(a, b)); }
+MMH_AVX512 inline __m512 Set(float x) { return _mm512_set1_ps(x); }
+MMH_AVX512 inline __m512 Add(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
+MMH_AVX512 inline __m512 Mul(__m512 a, __m512 b) { return _mm512_mul_ps(a, b); }
+// Low 16 / bits 0-13 of h as floats.
+MMH_AVX512 inline __m512 BitsToFloat(__m512i h, int mask) {
+  return _mm512_cvtepi32_ps(_mm512_and_si512(h, _mm512_set1_epi32(mask)));
+}
+
+MMH_AVX512 inline __m512 LnUnitx16(__m512 u) {
+  const __m512i bits = _mm512_castps_si512(u);
+  __m512i e = _mm512_sub_epi32(_mm512_srli_epi32(bits, 23), _mm512_set1_epi32(127));
+  __m512 m = _mm512_castsi512_ps(_mm512_or_si512(
+      _mm512_and_si512(bits, _mm512_set1_epi32(0x007fffff)), _mm512_set1_epi32(0x3f800000)));
+  const __mmask16 high = _mm512_cmp_ps_mask(m, Set(kSqrt2), _CMP_GE_OQ);
+  m = _mm512_mask_mul_ps(m, high, m, Set(0.5f));
+  e = _mm512_mask_add_epi32(e, high, e, _mm512_set1_epi32(1));
+  const __m512 s = _mm512_div_ps(_mm512_sub_ps(m, Set(1.0f)), Add(m, Set(1.0f)));
+  const __m512 s2 = Mul(s, s);
+  const __m512 series = Add(
+      Set(1.0f),
+      Mul(s2,
+          Add(Set(1.0f / 3),
+              Mul(s2, Add(Set(1.0f / 5), Mul(s2, Add(Set(1.0f / 7), Mul(s2, Set(1.0f / 9)))))))));
+  return Add(Mul(_mm512_cvtepi32_ps(e), Set(kLn2)), Mul(Mul(Set(2.0f), s), series));
+}
+
+MMH_AVX512 inline void BoxMullerx16(__m512i h, __m512* c, __m512* s) {
+  const __m512 u1 =
+      Mul(Add(_mm512_cvtepi32_ps(_mm512_srli_epi32(h, 16)), Set(0.5f)), Set(1.0f / 65536.0f));
+  const __m512 r = _mm512_sqrt_ps(Mul(Set(-2.0f), LnUnitx16(u1)));
+  const __m512i q = _mm512_and_si512(_mm512_srli_epi32(h, 14), _mm512_set1_epi32(3));
+  const __m512 t = Mul(Add(BitsToFloat(h, 0x3fff), Set(0.5f)), Set(1.0f / 16384.0f));
+  const __m512 x = Mul(_mm512_sub_ps(t, Set(0.5f)), Set(kHalfPi));
+  const __m512 x2 = Mul(x, x);
+  const __m512 sin_x =
+      Add(x, Mul(Mul(x, x2),
+                 Add(Set(-1.0f / 6),
+                     Mul(x2, Add(Set(1.0f / 120),
+                                 Mul(x2, Add(Set(-1.0f / 5040), Mul(x2, Set(1.0f / 362880)))))))));
+  const __m512 cos_x =
+      Add(Set(1.0f),
+          Mul(x2, Add(Set(-1.0f / 2),
+                      Mul(x2, Add(Set(1.0f / 24),
+                                  Mul(x2, Add(Set(-1.0f / 720),
+                                              Mul(x2, Add(Set(1.0f / 40320),
+                                                          Mul(x2, Set(-1.0f / 3628800)))))))))));
+  const __mmask16 odd = _mm512_test_epi32_mask(q, _mm512_set1_epi32(1));
+  const __m512 a = _mm512_mask_blend_ps(odd, cos_x, sin_x);
+  const __m512 b = _mm512_mask_blend_ps(odd, sin_x, cos_x);
+  const __mmask16 negate_cos = _mm512_cmpeq_epi32_mask(q, _mm512_set1_epi32(1)) |
+                               _mm512_cmpeq_epi32_mask(q, _mm512_set1_epi32(2));
+  const __mmask16 negate_sin = _mm512_cmpge_epi32_mask(q, _mm512_set1_epi32(2));
+  const __m512 sign = Set(-0.0f);
+  const __m512 cos_angle = _mm512_mask_xor_ps(a, negate_cos, a, sign);
+  const __m512 sin_angle = _mm512_mask_xor_ps(b, negate_sin, b, sign);
+  *c = Mul(r, cos_angle);
+  *s = Mul(r, sin_angle);
+}
 
 template <bool kQuantise>
 MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const float* row,
                                const float* down, const float* depth, const float* cos_incidence,
                                const uint8_t* occluded, uint32_t first_pixel, int n, uint8_t* edge,
-                               uint32_t* hash, uint16_t* out) {
+                               uint32_t* hash, float* normal, uint16_t* out) {
   // Pixel 0 and the tail that does not fill 16 lanes: the portable code.
-  out[0] = DepthPixel<kQuantise>(q, row[0], row[0], row[1], up[0], down[0], depth[0],
-                                 cos_incidence[0], occluded[0], first_pixel, &edge[0], &hash[0]);
+  out[0] =
+      DepthPixel<kQuantise>(q, row[0], row[0], row[1], up[0], down[0], depth[0], cos_incidence[0],
+                            occluded[0], first_pixel, &edge[0], &hash[0], &normal[0]);
   const __m512 zero = _mm512_setzero_ps();
-  const __m512 one = _mm512_set1_ps(1.0f);
-  const __m512 half = _mm512_set1_ps(0.5f);
-  const __m512 edge_jump = _mm512_set1_ps(q.edge_jump);
-  const __m512 cos_steps = _mm512_set1_ps(static_cast<float>(kCosSteps));
-  const __m512i max_step = _mm512_set1_epi32(kCosSteps);
-  const __m512 uniform = _mm512_set1_ps(1.0f / 65536.0f);
-  const __m512 z0 = _mm512_set1_ps(q.axial_z0), a = _mm512_set1_ps(q.axial_a),
-               b = _mm512_set1_ps(q.axial_b);
-  const __m512 lattice = _mm512_set1_ps(q.lattice), raw_offset = _mm512_set1_ps(q.raw_offset);
-  const __m512 raw_max = _mm512_set1_ps(2046.0f);
-  const __m512 min_depth = _mm512_set1_ps(q.min_depth), max_depth = _mm512_set1_ps(q.max_depth);
-  const __m512 inverse_scale = _mm512_set1_ps(q.inverse_scale);
-  const __m512 units_max = _mm512_set1_ps(65535.0f);
+  const __m512 one = Set(1.0f);
+  const __m512 half = Set(0.5f);
   int i = 1;
   for (; i + 16 < n; i += 16) {
     const __m512 d = _mm512_loadu_ps(row + i);
@@ -306,94 +370,85 @@ MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const floa
         _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i)));
     const __mmask16 keep = _mm512_cmp_ps_mask(d, zero, _CMP_NEQ_UQ) &
                            _mm512_cmpeq_epi32_mask(occ, _mm512_setzero_si512());
-    const __mmask16 is_edge = keep & _mm512_cmp_ps_mask(jump, edge_jump, _CMP_GT_OQ);
+    const __mmask16 is_edge = keep & _mm512_cmp_ps_mask(jump, Set(q.edge_jump), _CMP_GT_OQ);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(edge + i),
                      _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(is_edge, 1)));
-    const __m512i h = CounterHashx16(q.key_b, first_pixel + static_cast<uint32_t>(i));
+    const uint32_t counter = first_pixel + static_cast<uint32_t>(i);
+    const __m512i h = CounterHashx16(q.key_b, counter);
     _mm512_storeu_si512(hash + i, h);
+    __m512 g, unused;
+    BoxMullerx16(CounterHashx16(q.key_c, counter), &g, &unused);
+    _mm512_storeu_ps(normal + i, g);
     // DepthSample, lane-parallel.
-    __m512i step =
-        _mm512_cvttps_epi32(_mm512_mul_ps(_mm512_loadu_ps(cos_incidence + i), cos_steps));
-    step = _mm512_min_epi32(step, max_step);
-    const __m512 u_drop =
-        _mm512_mul_ps(_mm512_cvtepi32_ps(_mm512_and_si512(h, _mm512_set1_epi32(0xffff))), uniform);
+    __m512i step = _mm512_cvttps_epi32(
+        Mul(_mm512_loadu_ps(cos_incidence + i), Set(static_cast<float>(kCosSteps))));
+    step = _mm512_min_epi32(step, _mm512_set1_epi32(kCosSteps));
+    const __m512 u_drop = Mul(BitsToFloat(h, 0xffff), Set(1.0f / 65536.0f));
     const __m512 z = _mm512_mask_blend_ps(keep, one, _mm512_loadu_ps(depth + i));
-    const __m512 dz = _mm512_sub_ps(z, z0);
-    const __m512 sigma = _mm512_add_ps(
-        _mm512_add_ps(a, _mm512_mul_ps(_mm512_mul_ps(b, dz), dz)),
-        _mm512_div_ps(_mm512_i32gather_ps(step, q.grazing_sigma, 4), _mm512_sqrt_ps(z)));
-    const __m512 g = _mm512_i32gather_ps(_mm512_srli_epi32(h, 16), q.gauss, 4);
-    const __m512 zn = _mm512_add_ps(z, _mm512_mul_ps(sigma, g));
+    const __m512 dz = _mm512_sub_ps(z, Set(q.axial_z0));
+    const __m512 sigma =
+        Add(Add(Set(q.axial_a), Mul(Mul(Set(q.axial_b), dz), dz)),
+            _mm512_div_ps(_mm512_i32gather_ps(step, q.grazing_sigma, 4), _mm512_sqrt_ps(z)));
+    const __m512 zn = Add(z, Mul(sigma, g));
     __m512 zo = zn;
     __mmask16 valid = keep;
     if constexpr (kQuantise) {
-      const __m512 raw =
-          Floorx16(_mm512_add_ps(_mm512_sub_ps(raw_offset, _mm512_div_ps(lattice, zn)), half));
+      const __m512 lattice = Set(q.lattice), raw_offset = Set(q.raw_offset);
+      const __m512 raw = Floorx16(Add(_mm512_sub_ps(raw_offset, _mm512_div_ps(lattice, zn)), half));
       zo = _mm512_div_ps(lattice, _mm512_sub_ps(raw_offset, raw));
-      valid &=
-          _mm512_cmp_ps_mask(raw, zero, _CMP_GE_OQ) & _mm512_cmp_ps_mask(raw, raw_max, _CMP_LE_OQ);
+      valid &= _mm512_cmp_ps_mask(raw, zero, _CMP_GE_OQ) &
+               _mm512_cmp_ps_mask(raw, Set(2046.0f), _CMP_LE_OQ);
     }
     valid &= _mm512_cmp_ps_mask(u_drop, _mm512_i32gather_ps(step, q.drop, 4), _CMP_GE_OQ) &
-             _mm512_cmp_ps_mask(zo, min_depth, _CMP_GE_OQ) &
-             _mm512_cmp_ps_mask(zo, max_depth, _CMP_LE_OQ);
-    __m512 units = Floorx16(_mm512_add_ps(_mm512_mul_ps(zo, inverse_scale), half));
-    units = _mm512_min_ps(units, units_max);  // (units < max) ? units : max, as the scalar code
+             _mm512_cmp_ps_mask(zo, Set(q.min_depth), _CMP_GE_OQ) &
+             _mm512_cmp_ps_mask(zo, Set(q.max_depth), _CMP_LE_OQ);
+    __m512 units = Floorx16(Add(Mul(zo, Set(q.inverse_scale)), half));
+    units = _mm512_min_ps(units, Set(65535.0f));  // (units < max) ? units : max, as scalar
     units = _mm512_maskz_mov_ps(valid, units);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i),
                         _mm512_cvtepi32_epi16(_mm512_cvttps_epi32(units)));
   }
   for (; i < n; ++i) {
     const float right = i + 1 < n ? row[i + 1] : row[i];
-    out[i] = DepthPixel<kQuantise>(q, row[i - 1], row[i], right, up[i], down[i], depth[i],
-                                   cos_incidence[i], occluded[i],
-                                   first_pixel + static_cast<uint32_t>(i), &edge[i], &hash[i]);
+    out[i] = DepthPixel<kQuantise>(
+        q, row[i - 1], row[i], right, up[i], down[i], depth[i], cos_incidence[i], occluded[i],
+        first_pixel + static_cast<uint32_t>(i), &edge[i], &hash[i], &normal[i]);
   }
 }
 
-MMH_AVX512 void ColorRowAvx512(const uint8_t* in, uint32_t key, uint32_t first_counter, int n,
-                               const float* sigma, const float* gauss, uint16_t* index,
-                               uint8_t* out) {
-  const int pairs = (n + 1) / 2;
+// 16 bytes of NoisyColor.
+MMH_AVX512 inline void NoisyColorx16(const ColorParams& p, const uint8_t* in, __m512 g,
+                                     uint8_t* out) {
+  const __m512 v = _mm512_cvtepi32_ps(
+      _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in))));
+  const __m512 sigma = _mm512_sqrt_ps(Add(Set(p.read2), Mul(Set(p.gain), v)));
+  __m512 noisy = Floorx16(Add(Add(v, Mul(sigma, g)), Set(0.5f)));
+  const __m512 top = Set(255.0f);
+  noisy = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(noisy, top, _CMP_GT_OQ), noisy, top);
+  noisy = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(noisy, _mm512_setzero_ps(), _CMP_LT_OQ), noisy,
+                               _mm512_setzero_ps());
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out),
+                   _mm512_cvtepi32_epi8(_mm512_cvttps_epi32(noisy)));
+}
+
+MMH_AVX512 void ColorRowAvx512(const ColorParams& p, const uint8_t* in, uint32_t first_counter,
+                               int n, uint8_t* out) {
+  // 16 pairs (32 bytes) at a time: cos to the even bytes, sin to the odd ones.
+  const __m512i first_half =
+      _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+  const __m512i second_half =
+      _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
   int k = 0;
-  for (; k + 16 <= pairs; k += 16) {
-    // Two 12-bit indices per hash, as the portable kernel: index[2k] = h & 0xfff,
-    // index[2k + 1] = (h >> 16) & 0xfff (little-endian 16-bit halves).
-    const __m512i h = CounterHashx16(key, first_counter + static_cast<uint32_t>(k));
-    _mm512_storeu_si512(index + 2 * k, _mm512_and_si512(h, _mm512_set1_epi32(0x0fff0fff)));
+  for (; 2 * k + 32 <= n; k += 16) {
+    __m512 c, s;
+    BoxMullerx16(CounterHashx16(p.key, first_counter + static_cast<uint32_t>(k)), &c, &s);
+    NoisyColorx16(p, in + 2 * k, _mm512_permutex2var_ps(c, first_half, s), out + 2 * k);
+    NoisyColorx16(p, in + 2 * k + 16, _mm512_permutex2var_ps(c, second_half, s), out + 2 * k + 16);
   }
-  for (; k < pairs; ++k) {
-    const uint32_t h = CounterHash(key, first_counter + static_cast<uint32_t>(k));
-    index[2 * k] = static_cast<uint16_t>(h & 0xfffu);
-    index[2 * k + 1] = static_cast<uint16_t>((h >> 16) & 0xfffu);
-  }
-  const __m512 half = _mm512_set1_ps(0.5f);
-  const __m512 zero = _mm512_setzero_ps();
-  const __m512 top = _mm512_set1_ps(255.0f);
-  int j = 0;
-  for (; j + 16 <= n; j += 16) {
-    const __m512i value =
-        _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in + j)));
-    const __m512i idx =
-        _mm512_cvtepu16_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(index + j)));
-    const __m512 noisy = _mm512_add_ps(
-        _mm512_cvtepi32_ps(value),
-        _mm512_mul_ps(_mm512_i32gather_ps(value, sigma, 4), _mm512_i32gather_ps(idx, gauss, 4)));
-    __m512 r = Floorx16(_mm512_add_ps(noisy, half));
-    // noisy < 0 ? 0 : (noisy > 255 ? 255 : noisy), as the portable kernel.
-    r = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(r, top, _CMP_GT_OQ), r, top);
-    r = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(r, zero, _CMP_LT_OQ), r, zero);
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + j),
-                     _mm512_cvtepi32_epi8(_mm512_cvttps_epi32(r)));
-  }
-  for (; j < n; ++j) {
-    const uint8_t value = in[j];
-    float noisy = static_cast<float>(value) + sigma[value] * gauss[index[j]];
-    noisy = std::floor(noisy + 0.5f);
-    noisy = noisy < 0.0f ? 0.0f : (noisy > 255.0f ? 255.0f : noisy);
-    out[j] = static_cast<uint8_t>(static_cast<int>(noisy));
-  }
+  ColorRowPortable(p, in + 2 * k, first_counter + static_cast<uint32_t>(k), n - 2 * k, out + 2 * k);
 }
 #undef MMH_AVX512
+#pragma GCC diagnostic pop
 #endif  // MMH_SENSOR_AVX512
 
 bool UseAvx512Default() {
@@ -412,27 +467,28 @@ std::atomic<bool>& UseAvx512() {
 template <bool kQuantise>
 void DepthRow(const DepthParams& q, const float* up, const float* row, const float* down,
               const float* depth, const float* cos_incidence, const uint8_t* occluded,
-              uint32_t first_pixel, int n, uint8_t* edge, uint32_t* hash, uint16_t* out) {
+              uint32_t first_pixel, int n, uint8_t* edge, uint32_t* hash, float* normal,
+              uint16_t* out) {
 #if MMH_SENSOR_AVX512
-  if (UseAvx512().load(std::memory_order_relaxed)) {
+  if (n >= 2 && UseAvx512().load(std::memory_order_relaxed)) {
     DepthRowAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, first_pixel, n,
-                              edge, hash, out);
+                              edge, hash, normal, out);
     return;
   }
 #endif
-  DepthRowKernel<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, first_pixel, n, edge,
-                            hash, out);
+  DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, first_pixel, n,
+                              edge, hash, normal, out);
 }
 
-void ColorRow(const uint8_t* in, uint32_t key, uint32_t first_counter, int n, const float* sigma,
-              const float* gauss, uint16_t* index, uint8_t* out) {
+void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
+              uint8_t* out) {
 #if MMH_SENSOR_AVX512
   if (UseAvx512().load(std::memory_order_relaxed)) {
-    ColorRowAvx512(in, key, first_counter, n, sigma, gauss, index, out);
+    ColorRowAvx512(p, in, first_counter, n, out);
     return;
   }
 #endif
-  ColorRowKernel(in, key, first_counter, n, sigma, gauss, index, out);
+  ColorRowPortable(p, in, first_counter, n, out);
 }
 
 // Occlusion scan values of one row for a light source at x = source (see the header):
@@ -668,11 +724,10 @@ struct KinectSensor::Impl {
   float disparity_scale = 0;  // f b [px m] of the IR camera
   // Lookup tables.
   std::array<float, 256> srgb_to_linear{};
-  std::vector<uint8_t> linear_to_srgb;   // kEncodeSteps + 1
-  std::array<float, 256> color_sigma{};  // per 8-bit value
-  std::vector<float> lateral_cross;      // per cos step: P(offset rounds across the edge)
-  std::vector<float> drop;               // per cos step: P(grazing or speckle dropout)
-  std::vector<float> grazing_sigma;      // per cos step, times 1/sqrt(z) at use
+  std::vector<uint8_t> linear_to_srgb;  // kEncodeSteps + 1
+  std::vector<float> lateral_cross;     // per cos step: P(offset rounds across the edge)
+  std::vector<float> drop;              // per cos step: P(grazing or speckle dropout)
+  std::vector<float> grazing_sigma;     // per cos step, times 1/sqrt(z) at use
 
   View& depth_view() { return options.registered ? color_view : ir_view; }
   Rigid3 ColorTDepth() { return color_view.world_T_view.Inverse() * depth_view().world_T_view; }
@@ -682,19 +737,13 @@ struct KinectSensor::Impl {
   // neighbour across the largest jump).
   template <bool kQuantise>
   static void NoisyDepthRow(const DepthParams& q, const Geometry& g, int v, int w, int h,
-                            uint8_t* edge, uint32_t* hash, uint16_t* out) {
+                            uint8_t* edge, uint32_t* hash, float* normal, uint16_t* out) {
     const size_t row = static_cast<size_t>(v) * w;
     const float* d = &g.disparity[row];
     const float* up = v > 0 ? d - w : d;
     const float* down = v + 1 < h ? d + w : d;
-    if (w == 1) {
-      out[0] = DepthPixel<kQuantise>(q, d[0], d[0], d[0], up[0], down[0], g.depth[row],
-                                     g.cos_incidence[row], g.occluded[row],
-                                     static_cast<uint32_t>(row), edge, hash);
-    } else {
-      DepthRow<kQuantise>(q, up, d, down, &g.depth[row], &g.cos_incidence[row], &g.occluded[row],
-                          static_cast<uint32_t>(row), w, edge, hash, out);
-    }
+    DepthRow<kQuantise>(q, up, d, down, &g.depth[row], &g.cos_incidence[row], &g.occluded[row],
+                        static_cast<uint32_t>(row), w, edge, hash, normal, out);
     const float uniform = 1.0f / 65536.0f;
     for (int u = 0; u < w; ++u) {
       // Edges are rare: skip eight pixels at a time.
@@ -734,7 +783,8 @@ struct KinectSensor::Impl {
       // across the edge in half of the cases where it rounds to one pixel or more.
       if (u_lateral < q.lateral_cross[CosStep(g.cos_incidence[p])] &&
           std::isfinite(g.depth[across])) {
-        out[u] = DepthSample<kQuantise>(q, g.depth[across], g.cos_incidence[across], true, hash[u]);
+        out[u] = DepthSample<kQuantise>(q, g.depth[across], g.cos_incidence[across], true, hash[u],
+                                        normal[u]);
       }
     }
   }
@@ -945,8 +995,12 @@ struct KinectSensor::Impl {
         Mix64(options.seed ^ Mix64(static_cast<uint64_t>(index) + 0x632be59bd9b4e019ULL));
     q.key_a = static_cast<uint32_t>(frame_key);
     q.key_b = static_cast<uint32_t>(frame_key >> 32);
-    const auto color_key = static_cast<uint32_t>(Mix64(frame_key ^ 0xD1B54A32D192ED03ULL));
-    q.gauss = GaussTable().data();
+    const uint64_t more_keys = Mix64(frame_key ^ 0xD1B54A32D192ED03ULL);
+    q.key_c = static_cast<uint32_t>(more_keys >> 32);
+    ColorParams color_params;
+    color_params.key = static_cast<uint32_t>(more_keys);
+    color_params.read2 = static_cast<float>(options.color.read_noise * options.color.read_noise);
+    color_params.gain = static_cast<float>(options.color.shot_gain);
     q.noise = options.noise;
     q.quantise = options.quantise;
     q.lattice = static_cast<float>(options.calibration.lattice_constant());
@@ -969,23 +1023,24 @@ struct KinectSensor::Impl {
     const int cw = ck.width;
     const int ch = ck.height;
     const int color_pairs = (3 * cw + 1) / 2;  // hashes per colour row
-    const float* small_gauss = SmallGaussTable().data();
 
     // Depth and colour rows in one loop (one task wakes both cores once per frame).
     const int rows = std::max(dh, ch);
     tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& r) {
       std::vector<uint8_t> edge(dw);
       std::vector<uint32_t> hash(dw);
-      std::vector<uint16_t> index(3 * static_cast<size_t>(cw) + 1);
+      std::vector<float> normal(dw);
       for (int v = r.begin(); v != r.end(); ++v) {
         if (v < dh) {
           uint16_t* out = &frame->depth[static_cast<size_t>(v) * dw];
           if (!q.noise) {
             ExactDepthRow(q, dv.current, v, dw, out);
           } else if (q.quantise) {
-            NoisyDepthRow<true>(q, dv.current, v, dw, dh, edge.data(), hash.data(), out);
+            NoisyDepthRow<true>(q, dv.current, v, dw, dh, edge.data(), hash.data(), normal.data(),
+                                out);
           } else {
-            NoisyDepthRow<false>(q, dv.current, v, dw, dh, edge.data(), hash.data(), out);
+            NoisyDepthRow<false>(q, dv.current, v, dw, dh, edge.data(), hash.data(), normal.data(),
+                                 out);
           }
         }
         if (v < ch) {
@@ -993,9 +1048,9 @@ struct KinectSensor::Impl {
           if (!q.noise) {
             std::copy_n(&cv.current.color[row], 3 * cw, &frame->rgb[row]);
           } else {
-            ColorRow(&cv.current.color[row], color_key,
+            ColorRow(color_params, &cv.current.color[row],
                      static_cast<uint32_t>(v) * static_cast<uint32_t>(color_pairs), 3 * cw,
-                     color_sigma.data(), small_gauss, index.data(), &frame->rgb[row]);
+                     &frame->rgb[row]);
           }
         }
       }
@@ -1042,8 +1097,6 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
 
   for (int i = 0; i < 256; ++i) {
     s.srgb_to_linear[i] = static_cast<float>(SrgbToLinear(i / 255.0));
-    s.color_sigma[i] = static_cast<float>(std::sqrt(
-        options.color.read_noise * options.color.read_noise + options.color.shot_gain * i));
   }
   s.linear_to_srgb.resize(kEncodeSteps + 1);
   for (int i = 0; i <= kEncodeSteps; ++i) {
