@@ -9,6 +9,8 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <numeric>
 
 #include "core/error.h"
@@ -349,6 +351,138 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
     EXPECT_EQ(x.depth, y.depth) << "vector kernels in use: " << vector;
     EXPECT_EQ(x.rgb, y.rgb);
     EXPECT_GT(std::count(x.depth.begin(), x.depth.end(), 0), 100);
+  }
+}
+
+// Chi-squared goodness of fit of integer samples (offsets from their clean value) against a
+// normal N(0, sigma) rounded to integers (bins k = round(x); tails pooled where expected < 20).
+double RoundedNormalFitP(const std::vector<int>& offsets, double sigma) {
+  std::map<int, long> counts;
+  for (int k : offsets) ++counts[k];
+  const boost::math::normal normal(0.0, sigma);
+  const double n = offsets.size();
+  const int limit = static_cast<int>(std::ceil(5 * sigma));
+  double chi2 = 0;
+  int bins = 0;
+  long observed_tail = 0;
+  double expected_tail = 0;
+  for (int k = -limit - 20; k <= limit + 20; ++k) {
+    const double expected =
+        n * (boost::math::cdf(normal, k + 0.5) - boost::math::cdf(normal, k - 0.5));
+    const long observed = counts.count(k) ? counts[k] : 0;
+    if (expected < 20) {
+      observed_tail += observed;
+      expected_tail += expected;
+      continue;
+    }
+    chi2 += (observed - expected) * (observed - expected) / expected;
+    ++bins;
+  }
+  chi2 += (observed_tail - expected_tail) * (observed_tail - expected_tail) / expected_tail;
+  ++bins;
+  return boost::math::cdf(boost::math::complement(boost::math::chi_squared(bins - 1), chi2));
+}
+
+TEST(KinectSensor, DepthNoiseIsNormalWithTheModelledSigma) {
+  // quantise off: depth units are z + sigma_z g rounded to 0.2 mm; the offsets from z must follow
+  // the rounded N(0, sigma_z) (Box-Muller samples, tested bin by bin).
+  const double z = 1.0;
+  RayScene scene;
+  scene.AddStatic("wall", Quad(30, 30), FacingCamera(z, -Eigen::Vector3d::UnitZ()));
+  scene.Commit();
+  KinectSensorOptions options;
+  options.quantise = false;
+  options.seed = 5;
+  KinectSensor sensor(options, &scene, Rigid3::Identity());
+  const RgbdFrame frame = sensor.Render(2);
+  const int clean = static_cast<int>(std::lround(z / frame.depth_scale));
+  std::vector<int> offsets;
+  for (uint16_t d : frame.depth) {
+    if (d != 0) offsets.push_back(static_cast<int>(d) - clean);
+  }
+  ASSERT_GT(offsets.size(), 250000u);
+  const double sigma_units = options.axial.Sigma(z, 0.0) / frame.depth_scale;
+  EXPECT_GT(RoundedNormalFitP(offsets, sigma_units), 1e-3);
+}
+
+TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
+  RayScene scene;
+  TriangleMesh wall = Quad(30, 30);
+  wall.face_colors.setConstant(2, 3, 170);
+  scene.AddStatic("wall", wall, FacingCamera(1.2, -Eigen::Vector3d::UnitZ()));
+  scene.Commit();
+  KinectSensorOptions options;
+  options.seed = 9;
+  KinectSensor noisy(options, &scene, Rigid3::Identity());
+  options.noise = false;
+  KinectSensor exact(options, &scene, Rigid3::Identity());
+  const RgbdFrame x = noisy.Render(1);
+  const RgbdFrame clean = exact.Render(1);
+  const int value = clean.rgb[0];
+  for (uint8_t c : clean.rgb) ASSERT_EQ(c, value);  // flat wall, flat shading
+  ASSERT_GT(value, 30);
+  ASSERT_LT(value, 225);  // no clipping within 10 sigma
+  std::vector<int> offsets(x.rgb.size());
+  for (size_t i = 0; i < x.rgb.size(); ++i) offsets[i] = static_cast<int>(x.rgb[i]) - value;
+  const double sigma = std::sqrt(options.color.read_noise * options.color.read_noise +
+                                 options.color.shot_gain * value);
+  EXPECT_GT(RoundedNormalFitP(offsets, sigma), 1e-3);
+  // Neighbouring bytes (the two normals of one Box-Muller pair, and pairs next to each other)
+  // are uncorrelated: |r| below 4 standard errors.
+  for (int lag : {1, 2, 3}) {
+    double sxy = 0, sxx = 0;
+    for (size_t i = 0; i + lag < offsets.size(); ++i) {
+      sxy += offsets[i] * offsets[i + lag];
+      sxx += offsets[i] * offsets[i];
+    }
+    EXPECT_LT(std::abs(sxy / sxx), 4 / std::sqrt(static_cast<double>(offsets.size())))
+        << "lag " << lag;
+  }
+}
+
+TEST(KinectSensor, FrameParallelRenderingGivesTheSequentialFrames) {
+  // Three workers, each with its own scene in the state of the frame it renders.
+  auto make_scene = [](RayScene* scene) {
+    scene->AddStatic("wall", Quad(10, 10), FacingCamera(1.6, -Eigen::Vector3d::UnitZ()));
+    return scene->AddMoving("a", Box(0.1, 0.05, 0.08));
+  };
+  auto pose = [](RayScene* scene, uint32_t object, int i) {
+    scene->SetPose(object,
+                   Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.2 * i, Eigen::Vector3d::UnitY())),
+                          Eigen::Vector3d(-0.2 + 0.05 * i, 0.01 * i, 1.0)));
+    scene->Commit();
+  };
+  KinectSensorOptions options;
+  for (RenderMode mode : {RenderMode::kIncremental, RenderMode::kFull}) {
+    RayScene reference_scene;
+    const uint32_t reference_object = make_scene(&reference_scene);
+    pose(&reference_scene, reference_object, 0);
+    KinectSensor reference(options, &reference_scene, Rigid3::Identity());
+    std::vector<RgbdFrame> expected;
+    for (int i = 0; i < 9; ++i) {
+      pose(&reference_scene, reference_object, i);
+      expected.push_back(reference.Render(i, mode));
+    }
+    std::vector<std::unique_ptr<RayScene>> scenes;
+    std::vector<std::unique_ptr<KinectSensor>> sensors;
+    std::vector<SensorWorker> workers;
+    for (int w = 0; w < 3; ++w) {
+      scenes.push_back(std::make_unique<RayScene>());
+      const uint32_t object = make_scene(scenes.back().get());
+      pose(scenes.back().get(), object, 0);
+      sensors.push_back(
+          std::make_unique<KinectSensor>(options, scenes.back().get(), Rigid3::Identity()));
+      RayScene* scene = scenes.back().get();
+      workers.push_back({[=](int i) { pose(scene, object, i); }, sensors.back().get()});
+    }
+    std::vector<int> order;
+    RenderFrames(workers, 0, 9, mode, [&](const RgbdFrame& frame) {
+      order.push_back(frame.index);
+      ASSERT_EQ(frame.depth, expected[frame.index].depth) << "frame " << frame.index;
+      ASSERT_EQ(frame.rgb, expected[frame.index].rgb) << "frame " << frame.index;
+    });
+    EXPECT_EQ(order, std::vector<int>({0, 1, 2, 3, 4, 5, 6, 7, 8}));
+    EXPECT_EQ(TotalTimings(workers).frames, 9u);
   }
 }
 
