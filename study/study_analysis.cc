@@ -40,7 +40,9 @@ std::string Short(double value) {
 }
 
 std::string Interval(const ConfidenceInterval& ci) {
-  return Short(100.0 * ci.level) + "% CI [" + Short(ci.lower) + ", " + Short(ci.upper) + "]";
+  // An infinite end is open: [0.6, Inf).
+  return Short(100.0 * ci.level) + "% CI " + (std::isinf(ci.lower) ? "(" : "[") + Short(ci.lower) +
+         ", " + Short(ci.upper) + (std::isinf(ci.upper) ? ")" : "]");
 }
 
 // One row of tests.csv.
@@ -71,6 +73,28 @@ TestRow TRow(const std::string& analysis, const TTestResult& t) {
   row.effect_size_name = "cohens_d";
   row.effect_size = t.cohens_d;
   row.n = static_cast<double>(t.n);
+  return row;
+}
+
+TestRow FriedmanRow(const FriedmanResult& f) {
+  TestRow row{"rankings", "Friedman rank sum test", "chi-squared", f.statistic, f.df};
+  row.p_value = f.p_value;
+  row.effect_size_name = "kendalls_w";
+  row.effect_size = f.kendalls_w;
+  row.n = static_cast<double>(f.blocks);
+  return row;
+}
+
+TestRow BinomialRow(const std::string& analysis, const BinomialTestResult& b) {
+  TestRow row{analysis, "exact binomial test", "successes", static_cast<double>(b.successes)};
+  row.p_value = b.p_value;
+  row.estimate = b.estimate;
+  row.conf_low = b.conf_int.lower;
+  row.conf_high = b.conf_int.upper;
+  row.conf_level = b.conf_int.level;
+  row.effect_size_name = "cohens_h";
+  row.effect_size = b.cohens_h;
+  row.n = static_cast<double>(b.trials);
   return row;
 }
 
@@ -370,28 +394,10 @@ std::string StudyAnalysis::TestsCsv() const {
   std::string out =
       "analysis,test,statistic_name,statistic,df1,df2,p_value,estimate,conf_low,conf_high,"
       "conf_level,effect_size_name,effect_size,n\n";
-  if (const auto& f = rankings.friedman.result) {
-    TestRow row{"rankings", "Friedman rank sum test", "chi-squared", f->statistic, f->df};
-    row.p_value = f->p_value;
-    row.effect_size_name = "kendalls_w";
-    row.effect_size = f->kendalls_w;
-    row.n = static_cast<double>(f->blocks);
-    out += TestRowCsv(row);
-  }
+  if (rankings.friedman.result) out += TestRowCsv(FriedmanRow(*rankings.friedman.result));
   if (h1.t_test.result) out += TestRowCsv(TRow("h1", *h1.t_test.result));
   if (h1.chi_squared.result) out += TestRowCsv(ChiRow("h1", *h1.chi_squared.result));
-  if (const auto& b = h1.binomial.result) {
-    TestRow row{"h1", "exact binomial test", "successes", static_cast<double>(b->successes)};
-    row.p_value = b->p_value;
-    row.estimate = b->estimate;
-    row.conf_low = b->conf_int.lower;
-    row.conf_high = b->conf_int.upper;
-    row.conf_level = b->conf_int.level;
-    row.effect_size_name = "cohens_h";
-    row.effect_size = b->cohens_h;
-    row.n = static_cast<double>(b->trials);
-    out += TestRowCsv(row);
-  }
+  if (h1.binomial.result) out += TestRowCsv(BinomialRow("h1", *h1.binomial.result));
   if (h2.normality.result) out += TestRowCsv(ShapiroRow("h2", *h2.normality.result));
   if (h2.t_test.result) out += TestRowCsv(TRow("h2", *h2.t_test.result));
   if (const auto& m = h3.mixed_model.result) {

@@ -17,10 +17,7 @@ TEST(BinomialTest, MatchesRForEveryGoldenCase) {
     BinomialTestOptions options;
     options.p = c.at("p");
     options.conf_level = c.at("conf_level");
-    const std::string alternative = c.at("alternative");
-    options.alternative = alternative == "less"      ? Alternative::kLess
-                          : alternative == "greater" ? Alternative::kGreater
-                                                     : Alternative::kTwoSided;
+    options.alternative = golden::AlternativeNamed(c.at("alternative"));
     const BinomialTestResult r = BinomialTest(c.at("x"), c.at("n"), options);
     MMH_EXPECT_NEAR_R(r.p_value, c.at("p_value").get<double>());
     MMH_EXPECT_NEAR_R(r.estimate, c.at("estimate").get<double>());

@@ -14,6 +14,9 @@
 #include <string>
 #include <vector>
 
+#include "core/options.h"
+#include "study/htest.h"
+
 namespace mmh::study::golden {
 
 // The matching tolerance of the issue: 1e-10 relative.
@@ -62,6 +65,15 @@ inline ::testing::AssertionResult Near(double actual, double expected,
   return ::testing::AssertionFailure()
          << "got " << actual << ", R " << expected << " (relative difference "
          << std::abs(actual - expected) / std::abs(expected) << ", tolerance " << tolerance << ")";
+}
+
+// R's name of an alternative ("two.sided", "less", "greater").
+inline Alternative AlternativeNamed(const std::string& name) {
+  for (const auto& [value, text] : EnumNames(Alternative{})) {
+    if (name == text) return value;
+  }
+  ADD_FAILURE() << "unknown alternative " << name;
+  return Alternative::kTwoSided;
 }
 
 #define MMH_EXPECT_NEAR_R(actual, expected, ...) \

@@ -13,14 +13,6 @@ namespace {
 using golden::Golden;
 using golden::Number;
 
-Alternative AlternativeNamed(const std::string& name) {
-  for (const auto& [value, text] : EnumNames(Alternative{})) {
-    if (name == text) return value;
-  }
-  ADD_FAILURE() << name;
-  return Alternative::kTwoSided;
-}
-
 TEST(OneSampleTTest, MatchesRForEveryGoldenCase) {
   int compared = 0;
   for (const auto& c : Golden().at("t_test")) {
@@ -28,7 +20,7 @@ TEST(OneSampleTTest, MatchesRForEveryGoldenCase) {
     const std::vector<double> x = golden::Vector(c.at("x"));
     TTestOptions options;
     options.mu = c.at("mu");
-    options.alternative = AlternativeNamed(c.at("alternative"));
+    options.alternative = golden::AlternativeNamed(c.at("alternative"));
     options.conf_level = c.at("conf_level");
     if (c.contains("error")) {
       // R refuses (constant data): so do we, with R's reason in the message.
