@@ -6,10 +6,12 @@
 //
 // Counters: fps (wall clock), fps/core (frames per second of process CPU time: what one core
 // renders when it is not shared; the machine is shared with other builds, so this is the steadier
-// figure), rays/frame, rays/s (wall clock), and the share of the sensor's time per step.
+// figure), rays/frame, rays/s (wall clock), and the share of the sensor's time per step; for one
+// sensor also the fastest frame (best_ms) with its cast and noise steps.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <chrono>
 #include <ctime>
 #include <memory>
 #include <vector>
@@ -80,13 +82,31 @@ void BM_SensorFrame(benchmark::State& state) {
   s.sensor->ResetTimings();
   int i = 0;
   const double cpu0 = ProcessSeconds();
+  // The fastest frame and its steps: the machine is shared, the minimum is the least disturbed.
+  double best = 1e300;
+  mmh::sim::SensorTimings best_steps;
   for (auto _ : state) {
+    const mmh::sim::SensorTimings before = s.sensor->timings();
+    const auto t0 = std::chrono::steady_clock::now();
     s.Pose(i);
     s.sensor->Render(i, mode, &frame);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (seconds < best) {
+      best = seconds;
+      best_steps = s.sensor->timings();
+      best_steps.cast -= before.cast;
+      best_steps.restore -= before.restore;
+      best_steps.occlusion -= before.occlusion;
+      best_steps.noise -= before.noise;
+    }
     benchmark::DoNotOptimize(frame.depth.data());
     ++i;
   }
   Report(state, s.sensor->timings(), i, ProcessSeconds() - cpu0);
+  state.counters["best_ms"] = 1e3 * best;
+  state.counters["best_cast_ms"] = 1e3 * best_steps.cast;
+  state.counters["best_noise_ms"] = 1e3 * best_steps.noise;
 }
 BENCHMARK(BM_SensorFrame)
     ->ArgNames({"full", "threads"})

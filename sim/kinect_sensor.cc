@@ -55,17 +55,11 @@ double LinearToSrgb(double c) {
 }
 constexpr int kEncodeSteps = 4096;
 
-// Row spans covering the union of rectangles, merged per row.
-struct Rect {
-  int u0, v0, u1, v1;  // inclusive
-};
-std::vector<PixelSpan> SpansOfRects(const std::vector<Rect>& rects, int height) {
+// Spans of the union of column intervals per row (overlapping or touching ones merged).
+std::vector<PixelSpan> MergeRowIntervals(std::vector<std::vector<std::pair<int, int>>>& rows) {
   std::vector<PixelSpan> spans;
-  for (int v = 0; v < height; ++v) {
-    std::vector<std::pair<int, int>> row;
-    for (const Rect& r : rects) {
-      if (v >= r.v0 && v <= r.v1) row.emplace_back(r.u0, r.u1);
-    }
+  for (int v = 0; v < static_cast<int>(rows.size()); ++v) {
+    std::vector<std::pair<int, int>>& row = rows[v];
     if (row.empty()) continue;
     std::sort(row.begin(), row.end());
     int first = row[0].first;
@@ -82,6 +76,120 @@ std::vector<PixelSpan> SpansOfRects(const std::vector<Rect>& rects, int height) 
     spans.push_back({v, first, last});
   }
   return spans;
+}
+
+// Boxes (object frame) bounding a mesh's triangles in up to 2^depth groups, split at the median
+// along the longest axis of their centroids: a moving object's screen coverage is the union of
+// its boxes' projections, much tighter than one box for a bent arm.
+std::vector<Bounds3> ClusterBounds(const TriangleMesh& mesh, int depth) {
+  std::vector<int> faces(mesh.face_count());
+  std::iota(faces.begin(), faces.end(), 0);
+  auto centroid = [&](int f) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) c += mesh.vertices.row(mesh.faces(f, k)).transpose().cast<double>();
+    return Eigen::Vector3d(c / 3.0);
+  };
+  std::vector<Bounds3> boxes;
+  auto split = [&](auto&& self, std::vector<int>::iterator first, std::vector<int>::iterator last,
+                   int level) -> void {
+    if (first == last) return;
+    if (level == depth || last - first < 16) {
+      Bounds3 box;
+      for (auto it = first; it != last; ++it) {
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d p =
+              mesh.vertices.row(mesh.faces(*it, k)).transpose().template cast<double>();
+          box.min = box.min.cwiseMin(p);
+          box.max = box.max.cwiseMax(p);
+        }
+      }
+      boxes.push_back(box);
+      return;
+    }
+    Bounds3 spread;
+    for (auto it = first; it != last; ++it) {
+      const Eigen::Vector3d c = centroid(*it);
+      spread.min = spread.min.cwiseMin(c);
+      spread.max = spread.max.cwiseMax(c);
+    }
+    int axis = 0;
+    (spread.max - spread.min).maxCoeff(&axis);
+    auto middle = first + (last - first) / 2;
+    std::nth_element(first, middle, last,
+                     [&](int a, int b) { return centroid(a)[axis] < centroid(b)[axis]; });
+    self(self, first, middle, level + 1);
+    self(self, middle, last, level + 1);
+  };
+  split(split, faces.begin(), faces.end(), 0);
+  return boxes;
+}
+
+// Adds to each image row the column interval that a convex polygon (image coordinates, in order
+// around it) covers within one pixel: its x-extent over the band y in [v - 1, v + 1], widened by
+// one pixel.
+void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, int height,
+                        std::vector<std::vector<std::pair<int, int>>>* rows) {
+  double y_min = 1e300, y_max = -1e300;
+  for (const Eigen::Vector2d& p : polygon) {
+    y_min = std::min(y_min, p.y());
+    y_max = std::max(y_max, p.y());
+  }
+  const int v0 = std::max(0, static_cast<int>(std::floor(y_min)) - 1);
+  const int v1 = std::min(height - 1, static_cast<int>(std::ceil(y_max)) + 1);
+  const size_t n = polygon.size();
+  for (int v = v0; v <= v1; ++v) {
+    const double lo = v - 1.0, hi = v + 1.0;
+    double x_min = 1e300, x_max = -1e300;
+    for (size_t i = 0; i < n; ++i) {
+      const Eigen::Vector2d& a = polygon[i];
+      const Eigen::Vector2d& b = polygon[(i + 1) % n];
+      // The part of edge ab inside the band.
+      double t0 = 0.0, t1 = 1.0;
+      const double dy = b.y() - a.y();
+      if (dy == 0.0) {
+        if (a.y() < lo || a.y() > hi) continue;
+      } else {
+        double ta = (lo - a.y()) / dy, tb = (hi - a.y()) / dy;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 > t1) continue;
+      }
+      for (double t : {t0, t1}) {
+        const double x = a.x() + t * (b.x() - a.x());
+        x_min = std::min(x_min, x);
+        x_max = std::max(x_max, x);
+      }
+    }
+    if (x_min > x_max) continue;
+    const int u0 = std::max(0, static_cast<int>(std::floor(x_min)) - 1);
+    const int u1 = std::min(width - 1, static_cast<int>(std::ceil(x_max)) + 1);
+    if (u0 > u1) continue;
+    (*rows)[v].emplace_back(u0, u1);
+  }
+}
+
+// Convex hull of points (Andrew's monotone chain), counter-clockwise.
+std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> points) {
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (points.size() < 3) return points;
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  size_t k = 0;
+  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+  };
+  for (size_t i = 0; i < points.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);
+  return hull;
 }
 
 // Everything the per-pixel depth model needs, as floats for the vector loops.
@@ -199,38 +307,52 @@ inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, 
   return static_cast<uint16_t>(static_cast<int>(units));
 }
 
+// The random numbers of the depth pixels [first_pixel, first_pixel + n): pixels 2k and 2k + 1 take
+// the two normals of the Box-Muller pair of counter k (key_c) and the low and high 16 bits of the
+// key_b hash of k as their dropout uniforms.
+void DepthNoisePortable(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
+                        float* normal) {
+  for (int i = 0; i < n;) {
+    const uint32_t pixel = first_pixel + static_cast<uint32_t>(i);
+    const uint32_t pair = pixel >> 1;
+    float g[2];
+    BoxMuller(CounterHash(q.key_c, pair), &g[0], &g[1]);
+    const uint32_t h = CounterHash(q.key_b, pair);
+    const uint32_t bits[2] = {h & 0xffffu, h >> 16};
+    for (uint32_t b = pixel & 1u; b < 2 && i < n; ++b, ++i) {
+      normal[i] = g[b];
+      drop_bits[i] = bits[b];
+    }
+  }
+}
+
 // One pixel of the depth row's vector part: whether it is kept (something hit, not occluded) and
-// an edge (largest 4-neighbour disparity difference above edge_jump), its dropout hash (key_b)
-// and normal sample (Box-Muller of the key_c hash), and its sample as if it were no edge.
+// an edge (largest 4-neighbour disparity difference above edge_jump), and its sample as if it
+// were no edge.
 template <bool kQuantise>
 inline uint16_t DepthPixel(const DepthParams& q, float left, float d, float right, float up,
                            float down, float depth, float cos_incidence, uint8_t occluded,
-                           uint32_t counter, uint8_t* edge, uint32_t* hash, float* normal) {
+                           uint32_t drop_bits, float g, uint8_t* edge) {
   const float jump = std::max(std::max(std::abs(d - left), std::abs(d - right)),
                               std::max(std::abs(d - up), std::abs(d - down)));
   // Disparity 0: nothing hit.
   const bool keep = (d != 0.0f) & (occluded == 0);
   *edge = static_cast<uint8_t>(keep & (jump > q.edge_jump));
-  const uint32_t h = CounterHash(q.key_b, counter);
-  *hash = h;
-  float g, unused;
-  BoxMuller(CounterHash(q.key_c, counter), &g, &unused);
-  *normal = g;
-  return DepthSample<kQuantise>(q, depth, cos_incidence, keep, h, g);
+  return DepthSample<kQuantise>(q, depth, cos_incidence, keep, drop_bits, g);
 }
 
-// A row of DepthPixel (n >= 2; outside the image counts as equal: no jump).
+// A row of DepthPixel (outside the image counts as equal: no jump).
 template <bool kQuantise>
 void DepthRowPortable(const DepthParams& q, const float* up, const float* row, const float* down,
                       const float* depth, const float* cos_incidence, const uint8_t* occluded,
-                      uint32_t first_pixel, int n, uint8_t* edge, uint32_t* hash, float* normal,
-                      uint16_t* out) {
-  for (int i = 0; i < n; ++i) {
+                      const uint32_t* drop_bits, const float* normal, int first, int n,
+                      uint8_t* edge, uint16_t* out) {
+  for (int i = first; i < n; ++i) {
     const float left = i > 0 ? row[i - 1] : row[i];
     const float right = i + 1 < n ? row[i + 1] : row[i];
-    out[i] = DepthPixel<kQuantise>(
-        q, left, row[i], right, up[i], down[i], depth[i], cos_incidence[i], occluded[i],
-        first_pixel + static_cast<uint32_t>(i), &edge[i], &hash[i], &normal[i]);
+    out[i] =
+        DepthPixel<kQuantise>(q, left, row[i], right, up[i], down[i], depth[i], cos_incidence[i],
+                              occluded[i], drop_bits[i], normal[i], &edge[i]);
   }
 }
 
@@ -347,15 +469,44 @@ MMH_AVX512 inline void BoxMullerx16(__m512i h, __m512* c, __m512* s) {
   *s = Mul(r, sin_angle);
 }
 
+// DepthNoisePortable, 16 pairs (32 pixels) at a time.
+MMH_AVX512 void DepthNoiseAvx512(const DepthParams& q, uint32_t first_pixel, int n,
+                                 uint32_t* drop_bits, float* normal) {
+  const __m512i first_half =
+      _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+  const __m512i second_half =
+      _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+  // An odd first pixel is the second of its pair: the portable code takes it.
+  int i = static_cast<int>(first_pixel & 1u);
+  if (i == 1 && n > 0) DepthNoisePortable(q, first_pixel, 1, drop_bits, normal);
+  for (; i + 32 <= n; i += 32) {
+    const uint32_t pair = (first_pixel + static_cast<uint32_t>(i)) >> 1;
+    __m512 c, s;
+    BoxMullerx16(CounterHashx16(q.key_c, pair), &c, &s);
+    _mm512_storeu_ps(normal + i, _mm512_permutex2var_ps(c, first_half, s));
+    _mm512_storeu_ps(normal + i + 16, _mm512_permutex2var_ps(c, second_half, s));
+    const __m512i h = CounterHashx16(q.key_b, pair);
+    const __m512i low = _mm512_and_si512(h, _mm512_set1_epi32(0xffff));
+    const __m512i high = _mm512_srli_epi32(h, 16);
+    _mm512_storeu_si512(drop_bits + i, _mm512_permutex2var_epi32(low, first_half, high));
+    _mm512_storeu_si512(drop_bits + i + 16, _mm512_permutex2var_epi32(low, second_half, high));
+  }
+  if (i < n) {
+    DepthNoisePortable(q, first_pixel + static_cast<uint32_t>(i), n - i, drop_bits + i, normal + i);
+  }
+}
+
 template <bool kQuantise>
 MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const float* row,
                                const float* down, const float* depth, const float* cos_incidence,
-                               const uint8_t* occluded, uint32_t first_pixel, int n, uint8_t* edge,
-                               uint32_t* hash, float* normal, uint16_t* out) {
+                               const uint8_t* occluded, const uint32_t* drop_bits,
+                               const float* normal, int n, uint8_t* edge, uint16_t* out) {
   // Pixel 0 and the tail that does not fill 16 lanes: the portable code.
-  out[0] =
-      DepthPixel<kQuantise>(q, row[0], row[0], row[1], up[0], down[0], depth[0], cos_incidence[0],
-                            occluded[0], first_pixel, &edge[0], &hash[0], &normal[0]);
+  DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                              0, std::min(n, 1), edge, out);
+  if (n < 2) return;
+  out[0] = DepthPixel<kQuantise>(q, row[0], row[0], row[1], up[0], down[0], depth[0],
+                                 cos_incidence[0], occluded[0], drop_bits[0], normal[0], &edge[0]);
   const __m512 zero = _mm512_setzero_ps();
   const __m512 one = Set(1.0f);
   const __m512 half = Set(0.5f);
@@ -373,17 +524,13 @@ MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const floa
     const __mmask16 is_edge = keep & _mm512_cmp_ps_mask(jump, Set(q.edge_jump), _CMP_GT_OQ);
     _mm_storeu_si128(reinterpret_cast<__m128i*>(edge + i),
                      _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(is_edge, 1)));
-    const uint32_t counter = first_pixel + static_cast<uint32_t>(i);
-    const __m512i h = CounterHashx16(q.key_b, counter);
-    _mm512_storeu_si512(hash + i, h);
-    __m512 g, unused;
-    BoxMullerx16(CounterHashx16(q.key_c, counter), &g, &unused);
-    _mm512_storeu_ps(normal + i, g);
+    const __m512 g = _mm512_loadu_ps(normal + i);
     // DepthSample, lane-parallel.
     __m512i step = _mm512_cvttps_epi32(
         Mul(_mm512_loadu_ps(cos_incidence + i), Set(static_cast<float>(kCosSteps))));
     step = _mm512_min_epi32(step, _mm512_set1_epi32(kCosSteps));
-    const __m512 u_drop = Mul(BitsToFloat(h, 0xffff), Set(1.0f / 65536.0f));
+    const __m512 u_drop =
+        Mul(_mm512_cvtepi32_ps(_mm512_loadu_si512(drop_bits + i)), Set(1.0f / 65536.0f));
     const __m512 z = _mm512_mask_blend_ps(keep, one, _mm512_loadu_ps(depth + i));
     const __m512 dz = _mm512_sub_ps(z, Set(q.axial_z0));
     const __m512 sigma =
@@ -408,12 +555,8 @@ MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const floa
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i),
                         _mm512_cvtepi32_epi16(_mm512_cvttps_epi32(units)));
   }
-  for (; i < n; ++i) {
-    const float right = i + 1 < n ? row[i + 1] : row[i];
-    out[i] = DepthPixel<kQuantise>(
-        q, row[i - 1], row[i], right, up[i], down[i], depth[i], cos_incidence[i], occluded[i],
-        first_pixel + static_cast<uint32_t>(i), &edge[i], &hash[i], &normal[i]);
-  }
+  DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                              i, n, edge, out);
 }
 
 // 16 bytes of NoisyColor.
@@ -464,20 +607,23 @@ std::atomic<bool>& UseAvx512() {
   return use;
 }
 
+// One depth row: its random numbers (drop_bits, normal: #n scratch), then the pixels.
 template <bool kQuantise>
 void DepthRow(const DepthParams& q, const float* up, const float* row, const float* down,
               const float* depth, const float* cos_incidence, const uint8_t* occluded,
-              uint32_t first_pixel, int n, uint8_t* edge, uint32_t* hash, float* normal,
+              uint32_t first_pixel, int n, uint8_t* edge, uint32_t* drop_bits, float* normal,
               uint16_t* out) {
 #if MMH_SENSOR_AVX512
-  if (n >= 2 && UseAvx512().load(std::memory_order_relaxed)) {
-    DepthRowAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, first_pixel, n,
-                              edge, hash, normal, out);
+  if (UseAvx512().load(std::memory_order_relaxed)) {
+    DepthNoiseAvx512(q, first_pixel, n, drop_bits, normal);
+    DepthRowAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                              n, edge, out);
     return;
   }
 #endif
-  DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, first_pixel, n,
-                              edge, hash, normal, out);
+  DepthNoisePortable(q, first_pixel, n, drop_bits, normal);
+  DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                              0, n, edge, out);
 }
 
 void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
@@ -717,6 +863,7 @@ struct KinectSensor::Impl {
   std::vector<std::vector<uint8_t>> static_face_storage;
   std::vector<const uint8_t*> static_face_color;  // per object (ShadeStaticFaces)
   std::vector<bool> moving;
+  std::vector<std::vector<Bounds3>> moving_clusters;  // per object (ClusterBounds), object frame
   // Shading.
   float light[3] = {0, 0, 1};
   float ambient = 0, diffuse = 0;
@@ -852,41 +999,31 @@ struct KinectSensor::Impl {
     for (int u = 0; u < width; ++u) occluded[u] &= static_cast<uint8_t>(disparity[u] != 0.0f);
   }
 
+  // The pixels whose rays can hit a moving object: per object, the projections of its cluster
+  // boxes at its current pose, scan-converted with a pixel of margin (a ray through a pixel hits
+  // a box only if the pixel centre lies in the box's projected hull). An object reaching behind
+  // the camera covers the whole image.
   std::vector<PixelSpan> MovingSpans(const View& view) const {
     const Rigid3 view_T_world = view.world_T_view.Inverse();
     const PinholeIntrinsics& k = view.intrinsics;
-    std::vector<Rect> rects;
+    std::vector<std::vector<std::pair<int, int>>> rows(k.height);
+    std::vector<Eigen::Vector2d> corners(8);
     for (int o = 0; o < scene->object_count(); ++o) {
-      if (!moving[o]) continue;
-      const Bounds3 bounds = scene->WorldBounds(o);
-      if (bounds.empty()) continue;
-      double u_min = 1e300, u_max = -1e300, v_min = 1e300, v_max = -1e300;
-      bool behind = false;
-      for (int corner = 0; corner < 8; ++corner) {
-        const Eigen::Vector3d w((corner & 1) ? bounds.max.x() : bounds.min.x(),
-                                (corner & 2) ? bounds.max.y() : bounds.min.y(),
-                                (corner & 4) ? bounds.max.z() : bounds.min.z());
-        const Eigen::Vector3d c = view_T_world * w;
-        if (c.z() < 1e-3) {
-          behind = true;
-          break;
+      if (!moving[o] || scene->WorldBounds(o).empty()) continue;
+      const Rigid3 view_T_object = view_T_world * scene->world_T_object(o);
+      for (const Bounds3& box : moving_clusters[o]) {
+        for (int corner = 0; corner < 8; ++corner) {
+          const Eigen::Vector3d p((corner & 1) ? box.max.x() : box.min.x(),
+                                  (corner & 2) ? box.max.y() : box.min.y(),
+                                  (corner & 4) ? box.max.z() : box.min.z());
+          const Eigen::Vector3d c = view_T_object * p;
+          if (c.z() < 1e-3) return FullImageSpans(k);
+          corners[corner] = k.Project(c);
         }
-        const Eigen::Vector2d px = k.Project(c);
-        u_min = std::min(u_min, px.x());
-        u_max = std::max(u_max, px.x());
-        v_min = std::min(v_min, px.y());
-        v_max = std::max(v_max, px.y());
+        CoverConvexPolygon(ConvexHull(corners), k.width, k.height, &rows);
       }
-      if (behind) return FullImageSpans(k);
-      // One pixel of margin: a pixel whose ray grazes the bounds is still cast.
-      const int u0 = std::max(0, static_cast<int>(std::floor(u_min)) - 1);
-      const int u1 = std::min(k.width - 1, static_cast<int>(std::ceil(u_max)) + 1);
-      const int v0 = std::max(0, static_cast<int>(std::floor(v_min)) - 1);
-      const int v1 = std::min(k.height - 1, static_cast<int>(std::ceil(v_max)) + 1);
-      if (u0 > u1 || v0 > v1) continue;
-      rects.push_back({u0, v0, u1, v1});
     }
-    return SpansOfRects(rects, k.height);
+    return MergeRowIntervals(rows);
   }
 
   // Copies the cached static geometry of `spans` into the working buffers.
@@ -1069,6 +1206,8 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
   for (int o = 0; o < scene->object_count(); ++o) {
     s.face_colors.push_back(scene->object_mesh(o).face_colors.data());
     s.moving.push_back(scene->is_moving(o));
+    s.moving_clusters.push_back(s.moving.back() ? ClusterBounds(scene->object_mesh(o), 3)
+                                                : std::vector<Bounds3>());
   }
   // The IR camera sits at -ir_camera_offset along the colour camera's x axis, the projector a
   // baseline further along +x from the IR camera.
