@@ -51,13 +51,13 @@ struct Evaluation {
   Eigen::VectorXd group_residual;  // sum of e per group
   Eigen::MatrixXd w;               // #groups by p
   Eigen::VectorXd s;               // #groups
-  Eigen::MatrixXd s_matrix;        // S, #groups by #groups
+  Eigen::VectorXd d_diag;          // D = diag(n_i / (1 + n_i psi))
   double r2 = 0.0;
   double criterion = 0.0;
   double score = 0.0;
 };
 
-Evaluation Evaluate(const Design& d, double psi, bool with_s_matrix) {
+Evaluation Evaluate(const Design& d, double psi) {
   Evaluation ev;
   ev.psi = psi;
   const Eigen::Index p = static_cast<Eigen::Index>(d.p);
@@ -108,14 +108,10 @@ Evaluation Evaluate(const Design& d, double psi, bool with_s_matrix) {
   ev.w = d.group_x;
   for (Eigen::Index i = 0; i < m; ++i) ev.w.row(i) *= inv(i);
   ev.s = ev.group_residual.cwiseProduct(inv);
-  double trace_s = 0.0;
-  for (Eigen::Index i = 0; i < m; ++i) trace_s += d.group_size(i) * inv(i);
+  ev.d_diag = d.group_size.cwiseProduct(inv);
+  double trace_s = ev.d_diag.sum();
   trace_s -= (ev.m_inverse * (ev.w.transpose() * ev.w)).trace();
   ev.score = trace_s - residual_df * ev.s.squaredNorm() / ev.r2;
-  if (with_s_matrix) {
-    ev.s_matrix = -ev.w * ev.m_inverse * ev.w.transpose();
-    for (Eigen::Index i = 0; i < m; ++i) ev.s_matrix(i, i) += d.group_size(i) * inv(i);
-  }
   return ev;
 }
 
@@ -125,15 +121,15 @@ double BisectScore(const Design& d, double a, double b, int* evaluations) {
     const double mid = 0.5 * (a + b);
     if (!(mid > a && mid < b)) break;
     ++*evaluations;
-    if (Evaluate(d, mid, false).score < 0.0) {
+    if (Evaluate(d, mid).score < 0.0) {
       a = mid;
     } else {
       b = mid;
     }
   }
   // The end whose score is closer to zero.
-  const double sa = std::abs(Evaluate(d, a, false).score);
-  const double sb = std::abs(Evaluate(d, b, false).score);
+  const double sa = std::abs(Evaluate(d, a).score);
+  const double sb = std::abs(Evaluate(d, b).score);
   *evaluations += 2;
   return sa < sb ? a : b;
 }
@@ -348,7 +344,7 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
   }
   std::vector<double> scores;
   for (double psi : grid) {
-    const Evaluation ev = Evaluate(d, psi, false);
+    const Evaluation ev = Evaluate(d, psi);
     if (!(ev.r2 > 0.0) || !std::isfinite(ev.criterion)) {
       ThrowBadValue("mixed model scores", "a residual sum of squares of " + FormatNumber(ev.r2),
                     "scores that the fixed effects do not fit exactly (constant within takes?)");
@@ -370,16 +366,16 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
                   "data with residual variation within animators");
   }
   double psi = candidates[0];
-  double best = Evaluate(d, psi, false).criterion;
+  double best = Evaluate(d, psi).criterion;
   for (std::size_t i = 1; i < candidates.size(); ++i) {
-    const double value = Evaluate(d, candidates[i], false).criterion;
+    const double value = Evaluate(d, candidates[i]).criterion;
     if (value < best) {
       best = value;
       psi = candidates[i];
     }
   }
 
-  const Evaluation ev = Evaluate(d, psi, true);
+  const Evaluation ev = Evaluate(d, psi);
   const double residual_df = static_cast<double>(d.n - d.p);
   r.boundary = psi == 0.0;
   r.theta = std::sqrt(psi);
@@ -410,8 +406,20 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
   const double sigma = r.sigma;
   const double sigma2 = r.residual_variance;
   const double s_norm2 = ev.s.squaredNorm();
-  const double f_psi = ev.s_matrix.trace() - s_norm2 / sigma2;
-  const double f_psipsi = -ev.s_matrix.squaredNorm() + 2.0 * ev.s.dot(ev.s_matrix * ev.s) / sigma2;
+  // S = D - W M^-1 W' is #groups by #groups; its trace, |S|_F^2 and s'S s are formed from p by p
+  // products so that many animators cost O(m p^2), not O(m^2).
+  const Eigen::MatrixXd wtw = ev.w.transpose() * ev.w;
+  const Eigen::MatrixXd c_wtw = ev.m_inverse * wtw;
+  const Eigen::VectorXd wts = ev.w.transpose() * ev.s;
+  double d_quadratic = 0.0;  // sum_i D_i w_i' M^-1 w_i
+  for (Eigen::Index i = 0; i < m; ++i) {
+    d_quadratic += ev.d_diag(i) * ev.w.row(i).dot(ev.m_inverse * ev.w.row(i).transpose());
+  }
+  const double trace_s = ev.d_diag.sum() - c_wtw.trace();
+  const double s_frobenius2 = ev.d_diag.squaredNorm() - 2.0 * d_quadratic + (c_wtw * c_wtw).trace();
+  const double s_quadratic = ev.s.dot(ev.d_diag.cwiseProduct(ev.s)) - wts.dot(ev.m_inverse * wts);
+  const double f_psi = trace_s - s_norm2 / sigma2;
+  const double f_psipsi = -s_frobenius2 + 2.0 * s_quadratic / sigma2;
   const double f_psisigma = 2.0 * s_norm2 / (sigma2 * sigma);
   const double f_sigmasigma = 6.0 * ev.r2 / (sigma2 * sigma2) - 2.0 * residual_df / sigma2;
   Eigen::Matrix2d hessian;
@@ -438,8 +446,7 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
   const Eigen::Matrix2d varpar_covariance = 2.0 * hessian_pinv;
   // Jacobian of vcov(beta) = sigma^2 M^-1(theta^2): d/dtheta = sigma^2 2 theta M^-1 W'W M^-1,
   // d/dsigma = 2 sigma M^-1.
-  const Eigen::MatrixXd jac_theta =
-      sigma2 * 2.0 * r.theta * ev.m_inverse * (ev.w.transpose() * ev.w) * ev.m_inverse;
+  const Eigen::MatrixXd jac_theta = sigma2 * 2.0 * r.theta * ev.m_inverse * wtw * ev.m_inverse;
   const Eigen::MatrixXd jac_sigma = 2.0 * sigma * ev.m_inverse;
 
   // Contrast of the take effect: lmerTest uses type I contrasts for a model with one term (its
