@@ -205,6 +205,8 @@ struct DepthParams {
   const float* lateral_cross = nullptr;  // per cos step: P(the lateral offset crosses the edge)
   const float* drop = nullptr;           // per cos step: P(grazing or speckle dropout)
   const float* grazing_sigma = nullptr;  // per cos step: grazing term of sigma_z times sqrt(z)
+  // From this cos step on, grazing_sigma is 0 and drop equals drop[kCosSteps].
+  int flat_step = 0;
 };
 
 // Colour noise: sigma^2 = read2 + gain * value.
@@ -496,67 +498,90 @@ MMH_AVX512 void DepthNoiseAvx512(const DepthParams& q, uint32_t first_pixel, int
   }
 }
 
+// Pixels i .. i + 15 of DepthRowPortable; `last`: pixel i + 15 ends the row (its right
+// neighbour counts as equal).
+template <bool kQuantise>
+MMH_AVX512 inline void DepthBlockAvx512(const DepthParams& q, const float* up, const float* row,
+                                        const float* down, const float* depth,
+                                        const float* cos_incidence, const uint8_t* occluded,
+                                        const uint32_t* drop_bits, const float* normal, int i,
+                                        bool last, uint8_t* edge, uint16_t* out) {
+  const __m512 zero = _mm512_setzero_ps();
+  const __m512 half = Set(0.5f);
+  const __m512 d = _mm512_loadu_ps(row + i);
+  const __m512 right =
+      last ? _mm512_mask_loadu_ps(d, 0x7fff, row + i + 1) : _mm512_loadu_ps(row + i + 1);
+  const __m512 jump = _mm512_max_ps(
+      _mm512_max_ps(AbsDiff(d, _mm512_loadu_ps(row + i - 1)), AbsDiff(d, right)),
+      _mm512_max_ps(AbsDiff(d, _mm512_loadu_ps(up + i)), AbsDiff(d, _mm512_loadu_ps(down + i))));
+  const __m512i occ =
+      _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i)));
+  const __mmask16 keep = _mm512_cmp_ps_mask(d, zero, _CMP_NEQ_UQ) &
+                         _mm512_cmpeq_epi32_mask(occ, _mm512_setzero_si512());
+  const __mmask16 is_edge = keep & _mm512_cmp_ps_mask(jump, Set(q.edge_jump), _CMP_GT_OQ);
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(edge + i),
+                   _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(is_edge, 1)));
+  const __m512 g = _mm512_loadu_ps(normal + i);
+  // DepthSample, lane-parallel.
+  __m512i step = _mm512_cvttps_epi32(
+      Mul(_mm512_loadu_ps(cos_incidence + i), Set(static_cast<float>(kCosSteps))));
+  step = _mm512_min_epi32(step, _mm512_set1_epi32(kCosSteps));
+  const __m512 u_drop =
+      Mul(_mm512_cvtepi32_ps(_mm512_loadu_si512(drop_bits + i)), Set(1.0f / 65536.0f));
+  const __m512 z = _mm512_mask_blend_ps(keep, Set(1.0f), _mm512_loadu_ps(depth + i));
+  const __m512 dz = _mm512_sub_ps(z, Set(q.axial_z0));
+  __m512 sigma = Add(Set(q.axial_a), Mul(Mul(Set(q.axial_b), dz), dz));
+  __m512 drop = Set(q.drop[kCosSteps]);
+  // Steps from q.flat_step on have no grazing term (it is exactly 0, adding it changes nothing)
+  // and the dropout probability of the last step: no table lookups when all lanes are there.
+  if (_mm512_cmplt_epi32_mask(step, _mm512_set1_epi32(q.flat_step)) != 0) {
+    sigma =
+        Add(sigma, _mm512_div_ps(_mm512_i32gather_ps(step, q.grazing_sigma, 4), _mm512_sqrt_ps(z)));
+    drop = _mm512_i32gather_ps(step, q.drop, 4);
+  }
+  const __m512 zn = Add(z, Mul(sigma, g));
+  __m512 zo = zn;
+  __mmask16 valid = keep;
+  if constexpr (kQuantise) {
+    const __m512 lattice = Set(q.lattice), raw_offset = Set(q.raw_offset);
+    const __m512 raw = Floorx16(Add(_mm512_sub_ps(raw_offset, _mm512_div_ps(lattice, zn)), half));
+    zo = _mm512_div_ps(lattice, _mm512_sub_ps(raw_offset, raw));
+    valid &= _mm512_cmp_ps_mask(raw, zero, _CMP_GE_OQ) &
+             _mm512_cmp_ps_mask(raw, Set(2046.0f), _CMP_LE_OQ);
+  }
+  valid &= _mm512_cmp_ps_mask(u_drop, drop, _CMP_GE_OQ) &
+           _mm512_cmp_ps_mask(zo, Set(q.min_depth), _CMP_GE_OQ) &
+           _mm512_cmp_ps_mask(zo, Set(q.max_depth), _CMP_LE_OQ);
+  __m512 units = Floorx16(Add(Mul(zo, Set(q.inverse_scale)), half));
+  units = _mm512_min_ps(units, Set(65535.0f));  // (units < max) ? units : max, as scalar
+  units = _mm512_maskz_mov_ps(valid, units);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i),
+                      _mm512_cvtepi32_epi16(_mm512_cvttps_epi32(units)));
+}
+
 template <bool kQuantise>
 MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const float* row,
                                const float* down, const float* depth, const float* cos_incidence,
                                const uint8_t* occluded, const uint32_t* drop_bits,
                                const float* normal, int n, uint8_t* edge, uint16_t* out) {
-  // Pixel 0 and the tail that does not fill 16 lanes: the portable code.
+  if (n < 17) {
+    DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                                0, n, edge, out);
+    return;
+  }
+  // Pixel 0 (no left neighbour): the portable code.
   DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
-                              0, std::min(n, 1), edge, out);
-  if (n < 2) return;
-  out[0] = DepthPixel<kQuantise>(q, row[0], row[0], row[1], up[0], down[0], depth[0],
-                                 cos_incidence[0], occluded[0], drop_bits[0], normal[0], &edge[0]);
-  const __m512 zero = _mm512_setzero_ps();
-  const __m512 one = Set(1.0f);
-  const __m512 half = Set(0.5f);
+                              0, 1, edge, out);
   int i = 1;
   for (; i + 16 < n; i += 16) {
-    const __m512 d = _mm512_loadu_ps(row + i);
-    const __m512 jump = _mm512_max_ps(
-        _mm512_max_ps(AbsDiff(d, _mm512_loadu_ps(row + i - 1)),
-                      AbsDiff(d, _mm512_loadu_ps(row + i + 1))),
-        _mm512_max_ps(AbsDiff(d, _mm512_loadu_ps(up + i)), AbsDiff(d, _mm512_loadu_ps(down + i))));
-    const __m512i occ =
-        _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i)));
-    const __mmask16 keep = _mm512_cmp_ps_mask(d, zero, _CMP_NEQ_UQ) &
-                           _mm512_cmpeq_epi32_mask(occ, _mm512_setzero_si512());
-    const __mmask16 is_edge = keep & _mm512_cmp_ps_mask(jump, Set(q.edge_jump), _CMP_GT_OQ);
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(edge + i),
-                     _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(is_edge, 1)));
-    const __m512 g = _mm512_loadu_ps(normal + i);
-    // DepthSample, lane-parallel.
-    __m512i step = _mm512_cvttps_epi32(
-        Mul(_mm512_loadu_ps(cos_incidence + i), Set(static_cast<float>(kCosSteps))));
-    step = _mm512_min_epi32(step, _mm512_set1_epi32(kCosSteps));
-    const __m512 u_drop =
-        Mul(_mm512_cvtepi32_ps(_mm512_loadu_si512(drop_bits + i)), Set(1.0f / 65536.0f));
-    const __m512 z = _mm512_mask_blend_ps(keep, one, _mm512_loadu_ps(depth + i));
-    const __m512 dz = _mm512_sub_ps(z, Set(q.axial_z0));
-    const __m512 sigma =
-        Add(Add(Set(q.axial_a), Mul(Mul(Set(q.axial_b), dz), dz)),
-            _mm512_div_ps(_mm512_i32gather_ps(step, q.grazing_sigma, 4), _mm512_sqrt_ps(z)));
-    const __m512 zn = Add(z, Mul(sigma, g));
-    __m512 zo = zn;
-    __mmask16 valid = keep;
-    if constexpr (kQuantise) {
-      const __m512 lattice = Set(q.lattice), raw_offset = Set(q.raw_offset);
-      const __m512 raw = Floorx16(Add(_mm512_sub_ps(raw_offset, _mm512_div_ps(lattice, zn)), half));
-      zo = _mm512_div_ps(lattice, _mm512_sub_ps(raw_offset, raw));
-      valid &= _mm512_cmp_ps_mask(raw, zero, _CMP_GE_OQ) &
-               _mm512_cmp_ps_mask(raw, Set(2046.0f), _CMP_LE_OQ);
-    }
-    valid &= _mm512_cmp_ps_mask(u_drop, _mm512_i32gather_ps(step, q.drop, 4), _CMP_GE_OQ) &
-             _mm512_cmp_ps_mask(zo, Set(q.min_depth), _CMP_GE_OQ) &
-             _mm512_cmp_ps_mask(zo, Set(q.max_depth), _CMP_LE_OQ);
-    __m512 units = Floorx16(Add(Mul(zo, Set(q.inverse_scale)), half));
-    units = _mm512_min_ps(units, Set(65535.0f));  // (units < max) ? units : max, as scalar
-    units = _mm512_maskz_mov_ps(valid, units);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i),
-                        _mm512_cvtepi32_epi16(_mm512_cvttps_epi32(units)));
+    DepthBlockAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                                i, false, edge, out);
   }
-  DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
-                              i, n, edge, out);
+  // The last 16 pixels (again where they overlap the previous block: same values).
+  if (i < n) {
+    DepthBlockAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
+                                n - 16, true, edge, out);
+  }
 }
 
 // 16 bytes of NoisyColor.
@@ -565,13 +590,13 @@ MMH_AVX512 inline void NoisyColorx16(const ColorParams& p, const uint8_t* in, __
   const __m512 v = _mm512_cvtepi32_ps(
       _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in))));
   const __m512 sigma = _mm512_sqrt_ps(Add(Set(p.read2), Mul(Set(p.gain), v)));
-  __m512 noisy = Floorx16(Add(Add(v, Mul(sigma, g)), Set(0.5f)));
-  const __m512 top = Set(255.0f);
-  noisy = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(noisy, top, _CMP_GT_OQ), noisy, top);
-  noisy = _mm512_mask_blend_ps(_mm512_cmp_ps_mask(noisy, _mm512_setzero_ps(), _CMP_LT_OQ), noisy,
-                               _mm512_setzero_ps());
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(out),
-                   _mm512_cvtepi32_epi8(_mm512_cvttps_epi32(noisy)));
+  // floor, then noisy > 255 ? 255 : noisy, then noisy < 0 ? 0 : noisy, in integers (the sum is
+  // finite and far inside the int range): the same bytes as the float clamps of NoisyColor.
+  const __m512i noisy = _mm512_cvt_roundps_epi32(Add(Add(v, Mul(sigma, g)), Set(0.5f)),
+                                                 _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+  const __m512i clamped =
+      _mm512_max_epi32(_mm512_min_epi32(noisy, _mm512_set1_epi32(255)), _mm512_setzero_si512());
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm512_cvtepi32_epi8(clamped));
 }
 
 MMH_AVX512 void ColorRowAvx512(const ColorParams& p, const uint8_t* in, uint32_t first_counter,
@@ -875,6 +900,7 @@ struct KinectSensor::Impl {
   std::vector<float> lateral_cross;     // per cos step: P(offset rounds across the edge)
   std::vector<float> drop;              // per cos step: P(grazing or speckle dropout)
   std::vector<float> grazing_sigma;     // per cos step, times 1/sqrt(z) at use
+  int flat_step = kCosSteps;            // DepthParams::flat_step
 
   View& depth_view() { return options.registered ? color_view : ir_view; }
   Rigid3 ColorTDepth() { return color_view.world_T_view.Inverse() * depth_view().world_T_view; }
@@ -1155,6 +1181,7 @@ struct KinectSensor::Impl {
     q.lateral_cross = lateral_cross.data();
     q.drop = drop.data();
     q.grazing_sigma = grazing_sigma.data();
+    q.flat_step = flat_step;
     const int dw = dk.width;
     const int dh = dk.height;
     const int cw = ck.width;
@@ -1269,6 +1296,10 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
     // The grazing term of sigma_z without its 1 / sqrt(z) factor.
     s.grazing_sigma[i] =
         static_cast<float>(options.axial.Sigma(1.0, theta) - options.axial.Sigma(1.0, 0.0));
+  }
+  while (s.flat_step > 0 && s.grazing_sigma[s.flat_step - 1] == 0.0f &&
+         s.drop[s.flat_step - 1] == s.drop[kCosSteps]) {
+    --s.flat_step;
   }
   s.ShadeStaticFaces();
 }
