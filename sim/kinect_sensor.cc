@@ -1029,27 +1029,50 @@ struct KinectSensor::Impl {
   // boxes at its current pose, scan-converted with a pixel of margin (a ray through a pixel hits
   // a box only if the pixel centre lies in the box's projected hull). An object reaching behind
   // the camera covers the whole image.
-  std::vector<PixelSpan> MovingSpans(const View& view) const {
+  struct ObjectSpans {
+    uint32_t object;
+    std::vector<PixelSpan> spans;
+  };
+  // Per visible moving object its spans; `all` gets their union.
+  std::vector<ObjectSpans> MovingSpans(const View& view, std::vector<PixelSpan>* all) const {
     const Rigid3 view_T_world = view.world_T_view.Inverse();
     const PinholeIntrinsics& k = view.intrinsics;
-    std::vector<std::vector<std::pair<int, int>>> rows(k.height);
+    std::vector<ObjectSpans> result;
+    std::vector<std::vector<std::pair<int, int>>> union_rows(k.height);
     std::vector<Eigen::Vector2d> corners(8);
     for (int o = 0; o < scene->object_count(); ++o) {
       if (!moving[o] || scene->WorldBounds(o).empty()) continue;
       const Rigid3 view_T_object = view_T_world * scene->world_T_object(o);
+      std::vector<std::vector<std::pair<int, int>>> rows(k.height);
+      bool behind = false;
       for (const Bounds3& box : moving_clusters[o]) {
-        for (int corner = 0; corner < 8; ++corner) {
+        for (int corner = 0; corner < 8 && !behind; ++corner) {
           const Eigen::Vector3d p((corner & 1) ? box.max.x() : box.min.x(),
                                   (corner & 2) ? box.max.y() : box.min.y(),
                                   (corner & 4) ? box.max.z() : box.min.z());
           const Eigen::Vector3d c = view_T_object * p;
-          if (c.z() < 1e-3) return FullImageSpans(k);
+          behind = c.z() < 1e-3;
           corners[corner] = k.Project(c);
         }
+        if (behind) break;
         CoverConvexPolygon(ConvexHull(corners), k.width, k.height, &rows);
       }
+      ObjectSpans object{static_cast<uint32_t>(o), {}};
+      if (behind) {
+        object.spans = FullImageSpans(k);
+      } else {
+        for (int v = 0; v < k.height; ++v) {
+          union_rows[v].insert(union_rows[v].end(), rows[v].begin(), rows[v].end());
+        }
+        object.spans = MergeRowIntervals(rows);
+      }
+      if (!object.spans.empty()) result.push_back(std::move(object));
+      if (behind) {
+        for (int v = 0; v < k.height; ++v) union_rows[v].emplace_back(0, k.width - 1);
+      }
     }
-    return MergeRowIntervals(rows);
+    *all = MergeRowIntervals(union_rows);
+    return result;
   }
 
   // Copies the cached static geometry of `spans` into the working buffers.
@@ -1110,10 +1133,13 @@ struct KinectSensor::Impl {
       timings.restore += Seconds(t0, t1);
       t0 = t1;
     }
-    const std::vector<PixelSpan> spans = MovingSpans(view);
+    std::vector<PixelSpan> spans;
+    const std::vector<ObjectSpans> objects = MovingSpans(view, &spans);
+    // One object after the other, each bounded by the depth so far: the nearest hit wins.
     GeometrySink sink(*this, view, true);
-    scene->Cast(k, view.world_T_view, spans, RayScene::Target::kMoving, view.current.depth.data(),
-                &sink);
+    for (const ObjectSpans& o : objects) {
+      scene->CastObject(o.object, k, view.world_T_view, o.spans, view.current.depth.data(), &sink);
+    }
     auto t1 = Clock::now();
     timings.cast += Seconds(t0, t1);
     // Rows whose occlusion can differ from the cache: those touched now or last frame (others

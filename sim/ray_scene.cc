@@ -82,6 +82,21 @@ MMH_SIMD_CLONES void FinishLanes(const float* __restrict nx_in, const float* __r
   }
 }
 
+// Normals of a packet from an object's frame to the world.
+MMH_SIMD_CLONES void RotateNormals(const Eigen::Matrix3f& world_R_frame,
+                                   HitPacket* __restrict out) {
+  float r[9];
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) r[3 * row + col] = world_R_frame(row, col);
+  }
+  for (int i = 0; i < HitPacket::kLanes; ++i) {
+    const float x = out->normal_x[i], y = out->normal_y[i], z = out->normal_z[i];
+    out->normal_x[i] = r[0] * x + r[1] * y + r[2] * z;
+    out->normal_y[i] = r[3] * x + r[4] * y + r[5] * z;
+    out->normal_z[i] = r[6] * x + r[7] * y + r[8] * z;
+  }
+}
+
 }  // namespace
 
 void HitBuffer::Resize(int pixel_count) {
@@ -126,6 +141,15 @@ struct RayScene::Impl {
 
   std::mutex error_mutex;
   std::string error;
+
+  // How a hit's object is found: the static scene's geometry, the instance of the full or moving
+  // top-level scene, or one object cast on its own (CastObject).
+  enum class Lookup { kStaticGeometry, kFullInstance, kMovingInstance, kFixed };
+  // The camera rays of `spans` in the frame of `scene` (frame_T_camera); world_R_frame turns
+  // kFixed hits' normals to the world frame. Checks nothing: the callers do.
+  void CastRays(RTCScene scene, Lookup lookup, uint32_t fixed_object, const Rigid3& frame_T_camera,
+                const Eigen::Matrix3f& world_R_frame, const PinholeIntrinsics& intrinsics,
+                std::span<const PixelSpan> spans, const float* max_depth, HitSink* sink) const;
 
   static void OnError(void* user, RTCError code, const char* message) {
     auto* self = static_cast<Impl*>(user);
@@ -401,47 +425,90 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
 void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_camera,
                     std::span<const PixelSpan> spans, Target target, const float* max_depth,
                     HitSink* sink) const {
-  const bool moving_only = target == Target::kMoving;
   const Impl& s = *impl_;
   if (!s.static_built) throw std::logic_error("RayScene::Cast before Commit");
-  if (moving_only && max_depth == nullptr) {
+  if (target == Target::kMoving && max_depth == nullptr) {
     throw std::logic_error("RayScene::Cast: kMoving needs the depth bound of every pixel");
   }
+  const Impl::Lookup lookup = target == Target::kStatic ? Impl::Lookup::kStaticGeometry
+                              : target == Target::kAll  ? Impl::Lookup::kFullInstance
+                                                        : Impl::Lookup::kMovingInstance;
+  RTCScene scene = target == Target::kAll      ? s.full_scene
+                   : target == Target::kMoving ? s.moving_scene
+                                               : s.static_scene;
+  s.CastRays(scene, lookup, kNoObject, world_T_camera, Eigen::Matrix3f::Identity(), intrinsics,
+             spans, target == Target::kMoving ? max_depth : nullptr, sink);
+  impl_->Check();
+}
+
+void RayScene::CastObject(uint32_t object, const PinholeIntrinsics& intrinsics,
+                          const Rigid3& world_T_camera, std::span<const PixelSpan> spans,
+                          const float* max_depth, HitSink* sink) const {
+  const Impl& s = *impl_;
+  if (!s.static_built) throw std::logic_error("RayScene::CastObject before Commit");
+  const Impl::Object& o = s.objects.at(object);
+  if (!o.moving) throw std::logic_error("RayScene::CastObject on the static object " + o.name);
+  if (max_depth == nullptr) {
+    throw std::logic_error("RayScene::CastObject needs the depth bound of every pixel");
+  }
+  if (!o.visible) return;
+  // The rays in the object's frame: rigid, so the ray parameter (the depth) is unchanged.
+  const Rigid3 object_T_camera = o.world_T_object.Inverse() * world_T_camera;
+  s.CastRays(o.scene, Impl::Lookup::kFixed, object, object_T_camera,
+             o.world_T_object.rotation.normalized().toRotationMatrix().cast<float>(), intrinsics,
+             spans, max_depth, sink);
+  impl_->Check();
+}
+
+void RayScene::Impl::CastRays(RTCScene scene, Lookup lookup, uint32_t fixed_object,
+                              const Rigid3& frame_T_camera, const Eigen::Matrix3f& world_R_frame,
+                              const PinholeIntrinsics& intrinsics, std::span<const PixelSpan> spans,
+                              const float* max_depth, HitSink* sink) const {
+  const Impl& s = *this;
   const int width = intrinsics.width;
   const int height = intrinsics.height;
-  // 16-bit pixel masks of the 4x4 tiles touched by the spans.
+  // 16-bit pixel masks of the 4x4 tiles touched by the spans, within the tile rectangle that
+  // holds them (a few moving objects touch a small part of the image).
   const int tiles_x = (width + kTile - 1) / kTile;
   const int tiles_y = (height + kTile - 1) / kTile;
-  std::vector<uint16_t> tile_mask(static_cast<size_t>(tiles_x) * tiles_y, 0);
+  int tx0 = tiles_x, tx1 = -1, ty0 = tiles_y, ty1 = -1;
   for (const PixelSpan& span : spans) {
-    if (span.row < 0 || span.row >= height) continue;
     const int first = std::max(span.first, 0);
     const int last = std::min(span.last, width - 1);
-    if (first > last) continue;
-    uint16_t* row_masks = &tile_mask[static_cast<size_t>(span.row / kTile) * tiles_x];
+    if (span.row < 0 || span.row >= height || first > last) continue;
+    tx0 = std::min(tx0, first / kTile);
+    tx1 = std::max(tx1, last / kTile);
+    ty0 = std::min(ty0, span.row / kTile);
+    ty1 = std::max(ty1, span.row / kTile);
+  }
+  if (tx1 < tx0) return;
+  const int rect_width = tx1 - tx0 + 1;
+  std::vector<uint16_t> tile_mask(static_cast<size_t>(rect_width) * (ty1 - ty0 + 1), 0);
+  for (const PixelSpan& span : spans) {
+    const int first = std::max(span.first, 0);
+    const int last = std::min(span.last, width - 1);
+    if (span.row < 0 || span.row >= height || first > last) continue;
+    uint16_t* row_masks = &tile_mask[static_cast<size_t>(span.row / kTile - ty0) * rect_width];
     const int shift = (span.row % kTile) * kTile;
     for (int t = first / kTile; t <= last / kTile; ++t) {
       const int a = std::max(first, t * kTile) - t * kTile;
       const int b = std::min(last, t * kTile + kTile - 1) - t * kTile;
       const unsigned bits = ((1u << (b + 1)) - 1u) & ~((1u << a) - 1u);
-      row_masks[t] |= static_cast<uint16_t>(bits << shift);
+      row_masks[t - tx0] |= static_cast<uint16_t>(bits << shift);
     }
   }
-  std::vector<int> tiles;
+  std::vector<int> tiles;  // indices into tile_mask
   tiles.reserve(tile_mask.size());
   for (int t = 0; t < static_cast<int>(tile_mask.size()); ++t) {
     if (tile_mask[t] != 0) tiles.push_back(t);
   }
 
   const Eigen::Matrix3f world_R_camera =
-      world_T_camera.rotation.normalized().toRotationMatrix().cast<float>();
-  const Eigen::Vector3f origin = world_T_camera.translation.cast<float>();
-  RTCScene scene = target == Target::kAll      ? s.full_scene
-                   : target == Target::kMoving ? s.moving_scene
-                                               : s.static_scene;
+      frame_T_camera.rotation.normalized().toRotationMatrix().cast<float>();
+  const Eigen::Vector3f origin = frame_T_camera.translation.cast<float>();
   const std::vector<uint32_t>& instance_object =
-      moving_only ? s.moving_instance_object : s.full_instance_object;
-  const bool instanced = target != Target::kStatic;
+      lookup == Lookup::kMovingInstance ? s.moving_instance_object : s.full_instance_object;
+  const bool instanced = lookup == Lookup::kFullInstance || lookup == Lookup::kMovingInstance;
   // World rotations of the moving objects, to bring Embree's object-space normals to world.
   std::vector<Eigen::Matrix3f> world_R_object(s.objects.size(), Eigen::Matrix3f::Identity());
   for (size_t i = 0; i < s.objects.size(); ++i) {
@@ -493,8 +560,8 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
         alignas(64) float normal_x[16], normal_y[16], normal_z[16];
         for (size_t k = r.begin(); k != r.end(); ++k) {
           const int tile = tiles[k];
-          const int u0 = (tile % tiles_x) * kTile;
-          const int v0 = (tile / tiles_x) * kTile;
+          const int u0 = (tx0 + tile % rect_width) * kTile;
+          const int v0 = (ty0 + tile / rect_width) * kTile;
           const uint16_t mask = tile_mask[tile];
           for (int i = 0; i < 16; ++i) {
             valid[i] = ((mask >> i) & 1u) ? -1 : 0;
@@ -507,7 +574,7 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
                          packet.ray.dir_y);
           TileDirections(&column_part[2 * padded_width + u0], &row_part[2 * padded_height + v0],
                          packet.ray.dir_z);
-          if (moving_only) {
+          if (max_depth != nullptr) {
             for (int i = 0; i < 16; ++i) {
               if ((mask >> i) & 1u) {
                 packet.ray.tfar[i] =
@@ -550,6 +617,8 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
             nx = normal_x;
             ny = normal_y;
             nz = normal_z;
+          } else if (lookup == Lookup::kFixed) {
+            std::fill_n(out.object, 16, fixed_object);
           } else {
             for (int i = 0; i < 16; ++i) {
               out.object[i] =
@@ -559,12 +628,12 @@ void RayScene::Cast(const PinholeIntrinsics& intrinsics, const Rigid3& world_T_c
           std::copy_n(packet.hit.primID, 16, out.face);
           FinishLanes(nx, ny, nz, packet.ray.dir_x, packet.ray.dir_y, packet.ray.dir_z,
                       packet.ray.tfar, &out);
+          if (lookup == Lookup::kFixed) RotateNormals(world_R_frame, &out);
           sink->Consume(out);
         }
         cast.fetch_add(local_rays, std::memory_order_relaxed);
       });
-  impl_->rays.fetch_add(cast.load());
-  impl_->Check();
+  rays.fetch_add(cast.load());
 }
 
 }  // namespace mmh::sim

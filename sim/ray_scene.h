@@ -119,6 +119,15 @@ class RayScene {
             std::span<const PixelSpan> spans, Target target, const float* max_depth,
             HitSink* sink) const;
 
+  // The rays of `spans` against one moving object alone (its own BVH, the rays moved into its
+  // frame: no top-level traversal), bounded by max_depth (#height by #width, row-major): only
+  // nearer hits reach the sink. Cheaper than kMoving when the caller knows which pixels each
+  // object can cover; casting the objects one after another over a depth buffer that the sink
+  // updates gives the nearest hit of all of them. Nothing happens for a hidden object.
+  void CastObject(uint32_t object, const PinholeIntrinsics& intrinsics,
+                  const Rigid3& world_T_camera, std::span<const PixelSpan> spans,
+                  const float* max_depth, HitSink* sink) const;
+
   // Number of rays cast so far (for benchmarks).
   uint64_t rays_cast() const;
 

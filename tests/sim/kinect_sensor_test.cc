@@ -138,6 +138,49 @@ TEST(KinectSensor, BoxFrontFaceAndSilhouetteAreExact) {
   }
 }
 
+// sRGB of Lambertian shading, independently of the renderer's tables (IEC 61966-2-1).
+int ShadedSrgb(int albedo, const Eigen::Vector3d& normal, const ColorModel& model) {
+  const double c = albedo / 255.0;
+  const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  const Eigen::Vector3d light =
+      Eigen::Vector3d(model.light_x, model.light_y, model.light_z).normalized();
+  const double lit =
+      std::min(1.0, linear * (model.ambient + model.diffuse * std::max(0.0, normal.dot(light))));
+  const double encoded = lit <= 0.0031308 ? 12.92 * lit : 1.055 * std::pow(lit, 1 / 2.4) - 0.055;
+  return static_cast<int>(std::lround(255 * encoded));
+}
+
+TEST(KinectSensor, ColourIsTheLambertianShadingOfStaticAndMovingFaces) {
+  // A wall facing the camera and a turned box in front of it: the box's front face normal is the
+  // box's rotation applied to -z. Colour without noise must be their shading within one level
+  // (the renderer encodes through a 4096-step table).
+  RayScene scene;
+  TriangleMesh wall = Quad(10, 10);
+  wall.face_colors.rowwise() = Eigen::Matrix<uint8_t, 1, 3>(200, 120, 90);
+  scene.AddStatic("wall", wall, FacingCamera(1.5, -Eigen::Vector3d::UnitZ()));
+  TriangleMesh box = Box(0.2, 0.2, 0.05);
+  box.face_colors.rowwise() = Eigen::Matrix<uint8_t, 1, 3>(40, 160, 220);
+  const uint32_t a = scene.AddMoving("box", box);
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 0).normalized()));
+  scene.SetPose(a, Rigid3(turn, Eigen::Vector3d(0, 0, 1.0)));
+  scene.Commit();
+  KinectSensorOptions options = Exact();
+  KinectSensor sensor(options, &scene, Rigid3::Identity());
+  const RgbdFrame frame = sensor.Render(0);
+  const int centre = 3 * (240 * 640 + 320);
+  const int corner = 3 * (20 * 640 + 20);
+  const Eigen::Vector3d box_normal = turn * -Eigen::Vector3d::UnitZ();
+  const int box_albedo[3] = {40, 160, 220};
+  const int wall_albedo[3] = {200, 120, 90};
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(frame.rgb[centre + c], ShadedSrgb(box_albedo[c], box_normal, options.color), 1)
+        << "box channel " << c;
+    EXPECT_NEAR(frame.rgb[corner + c],
+                ShadedSrgb(wall_albedo[c], -Eigen::Vector3d::UnitZ(), options.color), 1)
+        << "wall channel " << c;
+  }
+}
+
 TEST(KinectSensor, EveryDepthLiesOnTheDisparityLattice) {
   RayScene scene;
   const Eigen::Vector3d n = Eigen::Vector3d(0.2, 0.5, -1.0).normalized();
