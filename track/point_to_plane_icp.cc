@@ -63,7 +63,8 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
     Eigen::Matrix<float, 6, 6> hf = Eigen::Matrix<float, 6, 6>::Zero();
     Eigen::Matrix<float, 6, 1> gf = Eigen::Matrix<float, 6, 1>::Zero();
     int used = 0, block = 0;
-    for (size_t i = 0; i < points.size(); ++i) {
+    const size_t fitted = options.fit_extra_points ? points.size() : scored;
+    for (size_t i = 0; i < fitted; ++i) {
       const Eigen::Vector3f rp = r * points[i];
       const Eigen::Vector3f s = rp + t;
       const int c = model.Closest(s);

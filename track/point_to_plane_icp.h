@@ -30,6 +30,9 @@ struct IcpOptions {
   double min_translation = 1e-4;
   // A correspondence counts as an inlier (for the result's statistics) within this distance [m].
   double inlier_distance = 0.006;
+  // Fit the extra points (skin-coloured ones) too, where they lie near the model; otherwise they
+  // only count in the result's extra_inliers.
+  bool fit_extra_points = true;
 
   template <class V>
   void VisitFields(V& v) {
@@ -41,6 +44,7 @@ struct IcpOptions {
     v("min_rotation", min_rotation);
     v("min_translation", min_translation);
     v("inlier_distance", inlier_distance);
+    v("fit_extra_points", fit_extra_points);
   }
   void Validate(const std::string& prefix) const;
 };

@@ -32,6 +32,9 @@ void DetectionOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".coarse_iterations", std::to_string(coarse_iterations), ">= 1");
   }
   if (candidates < 1) ThrowBadValue(prefix + ".candidates", std::to_string(candidates), ">= 1");
+  if (refine_points < 10) {
+    ThrowBadValue(prefix + ".refine_points", std::to_string(refine_points), ">= 10");
+  }
   RequirePositive(coarse_start_distance, prefix + ".coarse_start_distance", "m");
   RequirePositive(coarse_end_distance, prefix + ".coarse_end_distance", "m");
   RequirePositive(recheck_rotation_deg, prefix + ".recheck_rotation_deg", "deg");
@@ -41,6 +44,7 @@ void DetectionOptions::Validate(const std::string& prefix) const {
                   ">= 0 (0: never)");
   }
   RequireNonNegative(switch_margin, prefix + ".switch_margin");
+  RequireProbability(recheck_free_space, prefix + ".recheck_free_space");
   if (coarse_end_distance > coarse_start_distance) {
     ThrowBadValue(prefix + ".coarse_end_distance", FormatNumber(coarse_end_distance),
                   "at most coarse_start_distance");
@@ -284,14 +288,25 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
     }
     return a.Score() > b->Score();
   };
+  // Candidates are refined and ranked on at most refine_points segmented points (and the skin
+  // points among data_ in proportion); only the winner is refined on all of them.
+  std::vector<Eigen::Vector3f>& medium = detection_scratch_;
+  medium.clear();
+  const size_t medium_stride =
+      std::max<size_t>(1, (scored_ + o.refine_points - 1) / static_cast<size_t>(o.refine_points));
+  for (size_t i = 0; i < scored_; i += medium_stride) medium.push_back(data_[i]);
+  const size_t medium_scored = medium.size();
+  for (size_t i = scored_; i < data_.size(); i += medium_stride) medium.push_back(data_[i]);
+  auto refine = [&](const Rigid3& proxy_T_camera, const IcpOptions& icp) {
+    return AlignPointToPlane(*model_, medium, medium_scored, options_.verification.skin_distance,
+                             proxy_T_camera, icp);
+  };
   std::vector<Rigid3> refined_poses;
   std::optional<Candidate> best;
   for (size_t c = 0; c < order.size() && static_cast<int>(refined_poses.size()) < o.candidates &&
                      c < static_cast<size_t>(3 * o.candidates);
        ++c) {
-    const IcpResult refined =
-        AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                          coarse_results[order[c]].proxy_T_camera, options_.icp);
+    const IcpResult refined = refine(coarse_results[order[c]].proxy_T_camera, options_.icp);
     if (std::any_of(refined_poses.begin(), refined_poses.end(),
                     [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
       continue;
@@ -314,17 +329,18 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
             Eigen::AngleAxisd(quarter * pi / 2, Eigen::Vector3d::Unit(axis)));
         const Rigid3 proxy_T_twin(turn, center - turn * center);
         // Coarse first (the turn about the centre need not be the symmetry's), then fine.
-        const IcpResult coarse_twin =
-            AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                              (camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp);
-        const IcpResult refined =
-            AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                              coarse_twin.proxy_T_camera, options_.icp);
+        const IcpResult coarse_twin = refine((camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp);
+        const IcpResult refined = refine(coarse_twin.proxy_T_camera, options_.icp);
         if (same_pose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
         Candidate candidate = Verify(frame, refined);
         if (better(candidate, best)) best = candidate;
       }
     }
+  }
+  if (best) {
+    best = Verify(frame,
+                  AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                                    best->icp.proxy_T_camera, options_.icp));
   }
   return best;
 }
@@ -400,8 +416,18 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   for (size_t i = 0; i < segmentation_.points.size(); i += stride)
     data_.push_back(segmentation_.points[i]);
   scored_ = data_.size();
-  for (size_t i = 0; i < segmentation_.skin_points.size(); i += stride) {
-    data_.push_back(segmentation_.skin_points[i]);
+  // Skin points only within reach of the proxy (the segmented points' centroid plus the model's
+  // radius and the ICP's start distance): most of the hand and forearm can never lie on the model
+  // and would only cost time in every ICP iteration.
+  if (scored_ > 0) {
+    Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+    for (size_t i = 0; i < scored_; ++i) centroid += data_[i];
+    centroid /= static_cast<float>(scored_);
+    const float reach = model_->radius() + static_cast<float>(options_.icp.start_distance);
+    for (size_t i = 0; i < segmentation_.skin_points.size(); i += stride) {
+      const Eigen::Vector3f& p = segmentation_.skin_points[i];
+      if ((p - centroid).squaredNorm() <= reach * reach) data_.push_back(p);
+    }
   }
 
   const bool enough = result.points >= options_.verification.min_points;
@@ -425,6 +451,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     if (chosen && (RotationAngle(corrected.rotation, predicted.rotation) >
                        d.recheck_rotation_deg * std::numbers::pi / 180 ||
                    (corrected.translation - predicted.translation).norm() > d.recheck_translation ||
+                   candidate.free_space_violation > d.recheck_free_space ||
                    (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
       frames_since_detection_ = 0;
       std::optional<Candidate> detected = Detect(frame, predicted);

