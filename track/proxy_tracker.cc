@@ -127,12 +127,12 @@ bool ProxyTracker::EnsureTable(const RgbdFrame& frame, std::string* why) {
   return true;
 }
 
-ImageRect ProxyTracker::ProxyImage(const Rigid3& camera_T_proxy) const {
+ImageRect ProxyTracker::ProxyImage(const Rigid3& camera_T_proxy, double margin) const {
   const PinholeIntrinsics& k = *intrinsics_;
   const Eigen::Vector3d c = camera_T_proxy * model_->center().cast<double>();
   if (c.z() < 0.1) return {0, 0, k.width, k.height};
   const Eigen::Vector2d uv = k.Project(c);
-  const double r = (model_->radius() + 0.02) * k.fx / c.z() + 4;
+  const double r = (model_->radius() + margin) * k.fx / c.z() + 4;
   return {std::clamp(static_cast<int>(uv.x() - r), 0, k.width),
           std::clamp(static_cast<int>(uv.y() - r), 0, k.height),
           std::clamp(static_cast<int>(uv.x() + r) + 1, 0, k.width),
@@ -405,7 +405,12 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   if (!EnsureTable(frame, &why)) return lose(why);
   intrinsics_ = k;
 
-  segmenter_.Segment(frame, &segmentation_);
+  // With a prediction, only the predicted proxy's image is examined.
+  std::optional<Rigid3> predicted;
+  if (last_) predicted = velocity_ ? *velocity_ * *last_ : *last_;
+  ImageRect window;
+  if (predicted) window = ProxyImage(*predicted, options_.segmentation.window_margin);
+  segmenter_.Segment(frame, &segmentation_, predicted ? &window : nullptr);
   result.points = static_cast<int>(segmentation_.points.size());
   result.skin_points = static_cast<int>(segmentation_.skin_points.size());
   // ICP data: the segmented points evenly subsampled, then the skin points.
@@ -432,11 +437,10 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
 
   const bool enough = result.points >= options_.verification.min_points;
   std::optional<Candidate> chosen;
-  if (last_ && enough) {
-    const Rigid3 predicted = velocity_ ? *velocity_ * *last_ : *last_;
+  if (predicted && enough) {
     const IcpResult icp =
         AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                          predicted.Inverse(), options_.icp);
+                          predicted->Inverse(), options_.icp);
     Candidate candidate = Verify(frame, icp);
     if (candidate.good) {
       chosen = candidate;
@@ -448,11 +452,12 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     const Rigid3 corrected = icp.proxy_T_camera.Inverse();
     const DetectionOptions& d = options_.detection;
     ++frames_since_detection_;
-    if (chosen && (RotationAngle(corrected.rotation, predicted.rotation) >
-                       d.recheck_rotation_deg * std::numbers::pi / 180 ||
-                   (corrected.translation - predicted.translation).norm() > d.recheck_translation ||
-                   candidate.free_space_violation > d.recheck_free_space ||
-                   (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
+    if (chosen &&
+        (RotationAngle(corrected.rotation, predicted->rotation) >
+             d.recheck_rotation_deg * std::numbers::pi / 180 ||
+         (corrected.translation - predicted->translation).norm() > d.recheck_translation ||
+         candidate.free_space_violation > d.recheck_free_space ||
+         (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
       frames_since_detection_ = 0;
       std::optional<Candidate> detected = Detect(frame, predicted);
       if (detected && detected->good && detected->Score() > chosen->Score() + d.switch_margin) {
@@ -462,9 +467,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     }
   }
   if (!chosen && enough) {
-    std::optional<Candidate> detected =
-        Detect(frame, last_ ? std::optional<Rigid3>(velocity_ ? *velocity_ * *last_ : *last_)
-                            : std::nullopt);
+    std::optional<Candidate> detected = Detect(frame, predicted);
     frames_since_detection_ = 0;
     if (detected && detected->good) {
       chosen = detected;
@@ -489,7 +492,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     result.rms = chosen->icp.rms;
     result.free_space_violation = chosen->free_space_violation;
     result.iterations = chosen->icp.iterations;
-    segmenter_.UpdateBackground(frame, ProxyImage(camera_T_proxy));
+    segmenter_.UpdateBackground(frame, ProxyImage(camera_T_proxy, 0.02));
     return result;
   }
   if (!enough) {

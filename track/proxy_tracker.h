@@ -196,7 +196,8 @@ class ProxyTracker {
     double violation = 0.0;
   };
   Visibility ModelVisibility(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
-  ImageRect ProxyImage(const Rigid3& camera_T_proxy) const;
+  // The image of the model's bounding sphere grown by `margin` [m] (and 4 px).
+  ImageRect ProxyImage(const Rigid3& camera_T_proxy, double margin) const;
 
   ProxyTrackerOptions options_;
   TrackSetup setup_;

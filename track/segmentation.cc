@@ -42,6 +42,11 @@ void SegmentationOptions::Validate(const std::string& prefix) const {
   if (skin_cb_min > skin_cb_max) {
     ThrowBadValue(prefix + ".skin_cb_min", std::to_string(skin_cb_min), "<= skin_cb_max");
   }
+  if (background_interval < 1 || background_interval > 1000) {
+    ThrowBadValue(prefix + ".background_interval", std::to_string(background_interval),
+                  "an integer in [1, 1000]");
+  }
+  RequirePositive(window_margin, prefix + ".window_margin", "m");
   if (min_component_pixels < 1) {
     ThrowBadValue(prefix + ".min_component_pixels", std::to_string(min_component_pixels), ">= 1");
   }
@@ -100,18 +105,27 @@ void Segmenter::SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& 
   has_table_ = true;
 }
 
-void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out) {
+void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRect* window) {
   out->points.clear();
   out->components.clear();
   out->skin_points.clear();
   out->component_sizes.clear();
   out->foreground_pixels = out->skin_pixels = out->dropped_pixels = 0;
-  out->roi = roi_;
-  if (!has_table_ || roi_.empty()) return;
+  // The region examined: the play volume's image, within the window when one is given.
+  ImageRect region = roi_;
+  if (window) {
+    region.x0 = std::max(region.x0, window->x0);
+    region.y0 = std::max(region.y0, window->y0);
+    region.x1 = std::min(region.x1, window->x1);
+    region.y1 = std::min(region.y1, window->y1);
+  }
+  out->roi = region;
+  if (!has_table_ || region.empty()) return;
   const int width = intrinsics_.width, height = intrinsics_.height;
-  const int rw = roi_.x1 - roi_.x0, rh = roi_.y1 - roi_.y0;
+  const int rw = roi_.x1 - roi_.x0;  // row length of the per-ROI tables
+  const int gw = region.x1 - region.x0, gh = region.y1 - region.y0;
   const int step = options_.pixel_step;
-  const int mw = (rw + step - 1) / step, mh = (rh + step - 1) / step;
+  const int mw = (gw + step - 1) / step, mh = (gh + step - 1) / step;
 
   // Skin, where the colour image is registered to the depth image.
   cv::Mat skin;
@@ -122,7 +136,7 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out) {
   if (options_.skin && registered) {
     const cv::Mat rgb(height, width, CV_8UC3, const_cast<uint8_t*>(frame.rgb.data()));
     cv::Mat ycrcb;
-    cv::cvtColor(rgb(cv::Rect(roi_.x0, roi_.y0, rw, rh)), ycrcb, cv::COLOR_RGB2YCrCb);
+    cv::cvtColor(rgb(cv::Rect(region.x0, region.y0, gw, gh)), ycrcb, cv::COLOR_RGB2YCrCb);
     cv::inRange(ycrcb, cv::Scalar(0, options_.skin_cr_min, options_.skin_cb_min),
                 cv::Scalar(255, options_.skin_cr_max, options_.skin_cb_max), skin);
   }
@@ -137,21 +151,22 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out) {
   const float scale = static_cast<float>(frame.depth_scale);
   const float margin = static_cast<float>(options_.background_margin);
   for (int my = 0; my < mh; ++my) {
-    const int v = my * step;
-    const uint16_t* row = frame.depth.data() + static_cast<size_t>(roi_.y0 + v) * width + roi_.x0;
+    const int y = region.y0 + my * step;
+    const uint16_t* row = frame.depth.data() + static_cast<size_t>(y) * width;
+    const size_t table_row = static_cast<size_t>(y - roi_.y0) * rw - roi_.x0;
     for (int mx = 0; mx < mw; ++mx) {
-      const int u = mx * step;
-      const uint16_t d = row[u];
+      const int x = region.x0 + mx * step;
+      const uint16_t d = row[x];
       if (d == 0) continue;
       const float z = d * scale;
-      const size_t i = static_cast<size_t>(v) * rw + u;
+      const size_t i = table_row + x;
       const Eigen::Vector3f table_p = z * table_rays_[i] + origin;
       if (table_p.z() < z0 || table_p.z() > z1 || std::abs(table_p.x()) > hx ||
           std::abs(table_p.y()) > hy) {
         continue;
       }
       if (options_.background && background_[i] > 0 && z > background_[i] - margin) continue;
-      const bool is_skin = !skin.empty() && skin.at<uint8_t>(v, u) != 0;
+      const bool is_skin = !skin.empty() && skin.at<uint8_t>(y - region.y0, x - region.x0) != 0;
       mask_[static_cast<size_t>(my) * mw + mx] = is_skin ? 2 : 1;
       ++out->foreground_pixels;
     }
@@ -178,18 +193,19 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out) {
     rank[order[r]] = static_cast<int>(r);
     out->component_sizes.push_back(stats.at<int>(order[r], cv::CC_STAT_AREA));
   }
+  const float inverse_fx = static_cast<float>(1 / intrinsics_.fx);
+  const float inverse_fy = static_cast<float>(1 / intrinsics_.fy);
+  const float cx = static_cast<float>(intrinsics_.cx), cy = static_cast<float>(intrinsics_.cy);
   for (int my = 0; my < mh; ++my) {
-    const int v = my * step;
+    const int y = region.y0 + my * step;
     for (int mx = 0; mx < mw; ++mx) {
       const uint8_t m = mask_[static_cast<size_t>(my) * mw + mx];
       if (m == 0) continue;
       const int r = rank[labels.at<int>(my, mx)];
       if (r < 0) continue;
-      const int u = mx * step;
-      const float z = frame.depth[static_cast<size_t>(roi_.y0 + v) * width + roi_.x0 + u] * scale;
-      const Eigen::Vector3f p(
-          static_cast<float>((roi_.x0 + u - intrinsics_.cx) / intrinsics_.fx) * z,
-          static_cast<float>((roi_.y0 + v - intrinsics_.cy) / intrinsics_.fy) * z, z);
+      const int x = region.x0 + mx * step;
+      const float z = frame.depth[static_cast<size_t>(y) * width + x] * scale;
+      const Eigen::Vector3f p((x - cx) * inverse_fx * z, (y - cy) * inverse_fy * z, z);
       if (m == 2) {
         out->skin_points.push_back(p);
         ++out->skin_pixels;
@@ -203,6 +219,10 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out) {
 
 void Segmenter::UpdateBackground(const RgbdFrame& frame, const ImageRect& exclude) {
   if (!has_table_ || !options_.background) return;
+  // Every background_interval-th call learns; stability is counted in learning calls.
+  if (background_calls_++ % options_.background_interval != 0) return;
+  const int needed = (options_.background_frames + options_.background_interval - 1) /
+                     options_.background_interval;
   const int width = intrinsics_.width;
   const int rw = roi_.x1 - roi_.x0, rh = roi_.y1 - roi_.y0;
   const float scale = static_cast<float>(frame.depth_scale);
@@ -223,7 +243,7 @@ void Segmenter::UpdateBackground(const RgbdFrame& frame, const ImageRect& exclud
       if (stable_[i] > 0 && std::abs(z - running_[i]) <= tolerance) {
         if (stable_[i] < 65535) ++stable_[i];
         running_[i] += (z - running_[i]) / std::min<float>(stable_[i], 32.0f);
-        if (stable_[i] >= options_.background_frames) background_[i] = running_[i];
+        if (stable_[i] >= needed) background_[i] = running_[i];
       } else {
         running_[i] = z;
         stable_[i] = 1;

@@ -28,6 +28,8 @@ struct SegmentationOptions {
   // background by background_margin [m]. Pixels covered by the tracked proxy are not learnt.
   bool background = true;
   int background_frames = 90;
+  // The background learns from every background_interval-th frame (it changes slowly).
+  int background_interval = 4;
   double background_tolerance = 0.01;
   double background_margin = 0.02;
   // Skin: colour in the YCrCb box (Chai and Ngan 1999, Cr 133..173, Cb 77..127). Skin pixels are
@@ -40,6 +42,9 @@ struct SegmentationOptions {
   int skin_cb_max = 127;
   // Connected components (8-neighbourhood of foreground pixels) with fewer pixels are dropped.
   int min_component_pixels = 25;
+  // While tracking, only the predicted proxy's image is segmented: its bounding sphere grown by
+  // window_margin [m] (more than a frame's motion after the prediction).
+  double window_margin = 0.03;
 
   template <class V>
   void VisitFields(V& v) {
@@ -49,6 +54,7 @@ struct SegmentationOptions {
     v("max_height", max_height);
     v("background", background);
     v("background_frames", background_frames);
+    v("background_interval", background_interval);
     v("background_tolerance", background_tolerance);
     v("background_margin", background_margin);
     v("skin", skin);
@@ -57,6 +63,7 @@ struct SegmentationOptions {
     v("skin_cb_min", skin_cb_min);
     v("skin_cb_max", skin_cb_max);
     v("min_component_pixels", min_component_pixels);
+    v("window_margin", window_margin);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -91,8 +98,9 @@ class Segmenter {
   void SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& intrinsics);
   bool has_table() const { return has_table_; }
 
-  // Segments `frame` (of the intrinsics given to SetTable) into `out`.
-  void Segment(const RgbdFrame& frame, Segmentation* out);
+  // Segments `frame` (of the intrinsics given to SetTable) into `out`, only within `window` when
+  // given (the predicted proxy's image: the rest of the play area is not examined).
+  void Segment(const RgbdFrame& frame, Segmentation* out, const ImageRect* window = nullptr);
 
   // Learns the background from `frame`, leaving out `exclude` (the tracked proxy's image).
   void UpdateBackground(const RgbdFrame& frame, const ImageRect& exclude);
@@ -112,6 +120,7 @@ class Segmenter {
   std::vector<float> background_;
   std::vector<float> running_;
   std::vector<uint16_t> stable_;
+  uint64_t background_calls_ = 0;
   // Scratch.
   std::vector<uint8_t> mask_;
 };
