@@ -615,6 +615,55 @@ MMH_AVX512 void ColorRowAvx512(const ColorParams& p, const uint8_t* in, uint32_t
   }
   ColorRowPortable(p, in + 2 * k, first_counter + static_cast<uint32_t>(k), n - 2 * k, out + 2 * k);
 }
+// The occlusion scans of OccludeRow, 16 pixels at a time: exclusive suffix minima (prefix
+// maxima) inside a block by four shifted min (max) steps, carried across blocks. min and max are
+// exact, so the flags equal the scalar scan's. n: a multiple of 16 (us padded with `none`).
+MMH_AVX512 void OcclusionScanFromRightAvx512(const float* us, int n, uint8_t* occluded) {
+  const __m512 none = Set(std::numeric_limits<float>::infinity());
+  __m512 carry = none;  // minimum of everything right of the block, in every lane
+  for (int i = n - 16; i >= 0; i -= 16) {
+    const __m512 x = _mm512_loadu_ps(us + i);
+    // Lane j: minimum of lanes > j of this block.
+    __m512 m = _mm512_castsi512_ps(
+        _mm512_alignr_epi32(_mm512_castps_si512(none), _mm512_castps_si512(x), 1));
+    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
+                                                                 _mm512_castps_si512(m), 1)));
+    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
+                                                                 _mm512_castps_si512(m), 2)));
+    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
+                                                                 _mm512_castps_si512(m), 4)));
+    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
+                                                                 _mm512_castps_si512(m), 8)));
+    const __m512 lowest = _mm512_min_ps(m, carry);
+    const __mmask16 hidden = _mm512_cmp_ps_mask(x, lowest, _CMP_GE_OQ);
+    const __m128i old = _mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(occluded + i),
+                     _mm_or_si128(old, _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(hidden, 1))));
+    carry = _mm512_set1_ps(_mm512_reduce_min_ps(_mm512_min_ps(x, carry)));
+  }
+}
+
+MMH_AVX512 void OcclusionScanFromLeftAvx512(const float* us, int n, uint8_t* occluded) {
+  const __m512 none = Set(-std::numeric_limits<float>::infinity());
+  __m512 carry = none;  // maximum of everything left of the block
+  for (int i = 0; i < n; i += 16) {
+    const __m512 x = _mm512_loadu_ps(us + i);
+    // Lane j: maximum of lanes < j of this block.
+    __m512 m = _mm512_castsi512_ps(
+        _mm512_alignr_epi32(_mm512_castps_si512(x), _mm512_castps_si512(none), 15));
+    for (int k : {1, 2, 4, 8}) {
+      const __m512 shifted = _mm512_castsi512_ps(
+          _mm512_alignr_epi32(_mm512_castps_si512(m), _mm512_castps_si512(none), 16 - k));
+      m = _mm512_max_ps(m, shifted);
+    }
+    const __m512 highest = _mm512_max_ps(m, carry);
+    const __mmask16 hidden = _mm512_cmp_ps_mask(x, highest, _CMP_LE_OQ);
+    const __m128i old = _mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(occluded + i),
+                     _mm_or_si128(old, _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(hidden, 1))));
+    carry = _mm512_set1_ps(_mm512_reduce_max_ps(_mm512_max_ps(x, carry)));
+  }
+}
 #undef MMH_AVX512
 #pragma GCC diagnostic pop
 #endif  // MMH_SENSOR_AVX512
@@ -990,39 +1039,57 @@ struct KinectSensor::Impl {
     const double fx = view.intrinsics.fx;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 16),
                       [&](const tbb::blocked_range<size_t>& r) {
-                        std::vector<float> us(width);
+                        std::vector<float> us(width + 16);
+                        std::vector<uint8_t> scan(width + 16);
                         for (size_t k = r.begin(); k != r.end(); ++k) {
                           const size_t row = static_cast<size_t>(rows[k]) * width;
                           OccludeRow(&g.disparity[row], width, fx, view.occluder_sources, us.data(),
-                                     &g.occluded[row]);
+                                     scan.data(), &g.occluded[row]);
                         }
                       });
   }
 
+  // us and scan: scratch of at least width + 16 entries.
   void OccludeRow(const float* disparity, int width, double fx, const std::vector<double>& sources,
-                  float* us, uint8_t* occluded) const {
-    std::fill(occluded, occluded + width, 0);
+                  float* us, uint8_t* scan, uint8_t* occluded) const {
+    const int padded = (width + 15) / 16 * 16;
+    const bool vector = UseAvx512().load(std::memory_order_relaxed) && MMH_SENSOR_AVX512;
+    std::fill(scan, scan + padded, 0);
     for (double source_x : sources) {
       const auto shift = static_cast<float>(fx * source_x / disparity_scale);
+      // Pixels that see nothing never bound the scan.
+      const float none = (source_x > 0 ? 1.0f : -1.0f) * std::numeric_limits<float>::infinity();
+      SourceColumns(disparity, width, shift, none, us);
+      std::fill(us + width, us + padded, none);
+#if MMH_SENSOR_AVX512
+      if (vector) {
+        if (source_x > 0) {
+          OcclusionScanFromRightAvx512(us, padded, scan);
+        } else {
+          OcclusionScanFromLeftAvx512(us, padded, scan);
+        }
+        continue;
+      }
+#endif
       if (source_x > 0) {
         // Scanning from the source's side (+x): hidden iff not left of everything right of it.
-        SourceColumns(disparity, width, shift, std::numeric_limits<float>::infinity(), us);
         float lowest = std::numeric_limits<float>::infinity();
         for (int u = width - 1; u >= 0; --u) {
-          occluded[u] |= static_cast<uint8_t>(us[u] >= lowest);
+          scan[u] |= static_cast<uint8_t>(us[u] >= lowest);
           lowest = std::min(lowest, us[u]);
         }
       } else {
-        SourceColumns(disparity, width, shift, -std::numeric_limits<float>::infinity(), us);
         float highest = -std::numeric_limits<float>::infinity();
         for (int u = 0; u < width; ++u) {
-          occluded[u] |= static_cast<uint8_t>(us[u] <= highest);
+          scan[u] |= static_cast<uint8_t>(us[u] <= highest);
           highest = std::max(highest, us[u]);
         }
       }
     }
     // Pixels that see nothing are not occluded (they are missing anyway).
-    for (int u = 0; u < width; ++u) occluded[u] &= static_cast<uint8_t>(disparity[u] != 0.0f);
+    for (int u = 0; u < width; ++u) {
+      occluded[u] = static_cast<uint8_t>(scan[u] & static_cast<uint8_t>(disparity[u] != 0.0f));
+    }
   }
 
   // The pixels whose rays can hit a moving object: per object, the projections of its cluster
