@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
@@ -202,6 +203,12 @@ struct RayScene::Impl {
     return id;
   }
 
+  // Builds a scene's BVH on one thread (see the constructor).
+  void CommitScene(RTCScene scene) {
+    tbb::task_arena one_thread(1);
+    one_thread.execute([scene] { rtcCommitScene(scene); });
+  }
+
   RTCScene NewScene() {
     RTCScene scene = rtcNewScene(device);
     // Robust (watertight) traversal: no pixel may see through the crack between two triangles.
@@ -213,9 +220,11 @@ struct RayScene::Impl {
 };
 
 RayScene::RayScene() : impl_(std::make_unique<Impl>()) {
-  // One build thread: BVHs are then built the same way on every machine and thread count (the
-  // scenes are small; building them is not where the time goes).
-  impl_->device = rtcNewDevice("threads=1");
+  // Default threading: "threads=1" would make Embree install a process-wide
+  // tbb::global_control(max_allowed_parallelism, 1), serialising every TBB loop of the process
+  // (the sensor's, the compositor's, frame-parallel rendering). Builds run in a one-thread arena
+  // instead (Commit): BVHs are then built the same way on every machine and thread count.
+  impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) {
     throw std::runtime_error(std::string("Embree: cannot create a device: ") +
                              ErrorName(rtcGetDeviceError(nullptr)));
@@ -273,7 +282,7 @@ uint32_t RayScene::AddMoving(const std::string& name, const TriangleMesh& mesh) 
   RTCGeometry geometry = impl_->MakeTriangles(mesh, Rigid3::Identity());
   rtcAttachGeometry(object.scene, geometry);
   rtcReleaseGeometry(geometry);
-  rtcCommitScene(object.scene);
+  impl_->CommitScene(object.scene);
   impl_->Check();
   object.full_instance = impl_->AttachInstance(impl_->full_scene, object.scene);
   object.moving_instance = impl_->AttachInstance(impl_->moving_scene, object.scene);
@@ -313,7 +322,7 @@ void RayScene::SetVisible(uint32_t object, bool visible) {
 void RayScene::Commit() {
   Impl& s = *impl_;
   if (!s.static_built) {
-    rtcCommitScene(s.static_scene);
+    s.CommitScene(s.static_scene);
     s.Check();
     const unsigned id = s.AttachInstance(s.full_scene, s.static_scene);
     if (s.full_instance_object.size() <= id) s.full_instance_object.resize(id + 1, kNoObject);
@@ -337,8 +346,8 @@ void RayScene::Commit() {
     }
     o.dirty = false;
   }
-  rtcCommitScene(s.full_scene);
-  rtcCommitScene(s.moving_scene);
+  s.CommitScene(s.full_scene);
+  s.CommitScene(s.moving_scene);
   s.Check();
 }
 
