@@ -1,10 +1,8 @@
 #include "track/proxy_model.h"
 
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
 
 #include "core/error.h"
@@ -84,7 +82,7 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
     }
   }
 
-  // The grid: every cell centre's nearest sample (PCL's k-d tree, FLANN).
+  // The grid.
   const float resolution = static_cast<float>(options_.grid_resolution);
   inverse_resolution_ = 1.0f / resolution;
   grid_origin_ = (bounds.min.array() - options_.grid_margin).cast<float>();
@@ -97,24 +95,66 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
     ThrowBadValue("model.grid_resolution", FormatNumber(options_.grid_resolution),
                   "a coarser grid: " + std::to_string(cells) + " cells exceed 64 M");
   }
-  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  cloud->reserve(points_.size());
-  for (const auto& p : points_) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-  pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-  tree.setInputCloud(cloud);
-  grid_.resize(cells);
-  std::vector<int> index(1);
-  std::vector<float> distance(1);
-  size_t i = 0;
-  for (int z = 0; z < dims_[2]; ++z) {
-    for (int y = 0; y < dims_[1]; ++y) {
-      for (int x = 0; x < dims_[0]; ++x, ++i) {
-        const Eigen::Vector3f c =
-            grid_origin_ + resolution * Eigen::Vector3f(x + 0.5f, y + 0.5f, z + 0.5f);
-        tree.nearestKSearch(pcl::PointXYZ(c.x(), c.y(), c.z()), 1, index, distance);
-        grid_[i] = index[0];
+  // Every cell centre's nearest sample by vector propagation (Danielsson 1980, "Euclidean distance
+  // mapping"): seed each cell with the nearest sample inside it, then sweep the grid forward and
+  // backward, each cell taking a neighbour's sample when that one is nearer to its centre. Two
+  // double sweeps; the result is the true nearest sample or one within a fraction of a cell of it
+  // (the ICP uses the sample's face plane, which such a neighbour shares).
+  grid_.assign(cells, -1);
+  std::vector<float> best(cells, std::numeric_limits<float>::infinity());
+  auto center_of = [&](int x, int y, int z) {
+    return Eigen::Vector3f(grid_origin_ +
+                           resolution * Eigen::Vector3f(x + 0.5f, y + 0.5f, z + 0.5f));
+  };
+  const size_t sx = 1, sy = dims_[0], sz = static_cast<size_t>(dims_[0]) * dims_[1];
+  for (int i = 0; i < static_cast<int>(points_.size()); ++i) {
+    const Eigen::Vector3f g = (points_[i] - grid_origin_) * inverse_resolution_;
+    const int x = std::clamp(static_cast<int>(g.x()), 0, dims_[0] - 1);
+    const int y = std::clamp(static_cast<int>(g.y()), 0, dims_[1] - 1);
+    const int z = std::clamp(static_cast<int>(g.z()), 0, dims_[2] - 1);
+    const size_t c = z * sz + y * sy + x * sx;
+    const float d = (points_[i] - center_of(x, y, z)).squaredNorm();
+    if (d < best[c]) {
+      best[c] = d;
+      grid_[c] = i;
+    }
+  }
+  auto sweep = [&](int direction) {
+    const int x0 = direction > 0 ? 0 : dims_[0] - 1, x1 = direction > 0 ? dims_[0] : -1;
+    const int y0 = direction > 0 ? 0 : dims_[1] - 1, y1 = direction > 0 ? dims_[1] : -1;
+    const int z0 = direction > 0 ? 0 : dims_[2] - 1, z1 = direction > 0 ? dims_[2] : -1;
+    for (int z = z0; z != z1; z += direction) {
+      for (int y = y0; y != y1; y += direction) {
+        for (int x = x0; x != x1; x += direction) {
+          const size_t c = z * sz + y * sy + x * sx;
+          const Eigen::Vector3f center = center_of(x, y, z);
+          // The 13 neighbours already visited in this sweep's order.
+          for (int dz = -1; dz <= 0; ++dz) {
+            for (int dy = -1; dy <= 1; ++dy) {
+              for (int dx = -1; dx <= 1; ++dx) {
+                if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
+                const int nx = x + direction * dx, ny = y + direction * dy, nz = z + direction * dz;
+                if (nx < 0 || ny < 0 || nz < 0 || nx >= dims_[0] || ny >= dims_[1] ||
+                    nz >= dims_[2]) {
+                  continue;
+                }
+                const int candidate = grid_[nz * sz + ny * sy + nx * sx];
+                if (candidate < 0 || candidate == grid_[c]) continue;
+                const float d = (points_[candidate] - center).squaredNorm();
+                if (d < best[c]) {
+                  best[c] = d;
+                  grid_[c] = candidate;
+                }
+              }
+            }
+          }
+        }
       }
     }
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    sweep(+1);
+    sweep(-1);
   }
 }
 
