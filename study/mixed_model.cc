@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -208,6 +210,7 @@ std::string Describe(const FTest& t) {
 
 void MixedModelOptions::Validate(const std::string& prefix) const {
   RequirePositive(hessian_tolerance, prefix + ".hessian_tolerance");
+  RequireConfidenceLevel(conf_level, prefix + ".conf_level");
   if (grid_points_per_decade < 1 || grid_points_per_decade > 100) {
     ThrowBadValue(prefix + ".grid_points_per_decade", std::to_string(grid_points_per_decade),
                   "an integer in [1, 100]");
@@ -222,6 +225,16 @@ nlohmann::json FTest::ToJson() const {
           {"sum_sq", sum_sq},
           {"mean_sq", mean_sq},
           {"partial_eta_squared", partial_eta_squared}};
+}
+
+nlohmann::json FixedEffect::ToJson() const {
+  return {{"name", name},
+          {"estimate", estimate},
+          {"standard_error", standard_error},
+          {"df", FiniteOrNull(df)},
+          {"t", t},
+          {"p_value", p_value},
+          {"conf_int", conf_int.ToJson()}};
 }
 
 nlohmann::json MixedModelSummary::ToJson() const {
@@ -251,6 +264,9 @@ nlohmann::json MixedModelResult::ToJson() const {
     cov.push_back(row);
   }
   j["beta_covariance"] = cov;
+  nlohmann::json effects = nlohmann::json::array();
+  for (const auto& e : fixed_effects) effects.push_back(e.ToJson());
+  j["fixed_effects"] = effects;
   j["direction_df"] = direction_df;
   j["take_test"] = take_test.ToJson();
   j["rm_anova"] = rm_anova ? rm_anova->ToJson() : nlohmann::json(nullptr);
@@ -449,6 +465,36 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
   const Eigen::MatrixXd jac_theta = sigma2 * 2.0 * r.theta * ev.m_inverse * wtw * ev.m_inverse;
   const Eigen::MatrixXd jac_sigma = 2.0 * sigma * ev.m_inverse;
 
+  // One-dimensional Satterthwaite df of a contrast l: 2 (l'Vl)^2 / (g'A g), g the gradient of
+  // l'Vl in (theta, sigma) (lmerTest's contest1D).
+  const auto satterthwaite = [&](const Eigen::RowVectorXd& l, double variance) {
+    const Eigen::Vector2d gradient(l * jac_theta * l.transpose(), l * jac_sigma * l.transpose());
+    const double v = gradient.dot(varpar_covariance * gradient);
+    return v > 0.0 ? 2.0 * variance * variance / v : std::numeric_limits<double>::infinity();
+  };
+  for (Eigen::Index j = 0; j < p; ++j) {
+    FixedEffect e;
+    e.name = j == 0 ? "(Intercept)" : "take" + std::to_string(j + 1);
+    const Eigen::RowVectorXd l = Eigen::RowVectorXd::Unit(p, j);
+    const double variance = r.beta_covariance(j, j);
+    e.estimate = r.beta(j);
+    e.standard_error = std::sqrt(variance);
+    e.df = satterthwaite(l, variance);
+    e.t = e.estimate / e.standard_error;
+    double half = 0.0;
+    if (std::isfinite(e.df)) {
+      const bm::students_t_distribution<double> dist(e.df);
+      e.p_value = 2.0 * bm::cdf(bm::complement(dist, std::abs(e.t)));
+      half = bm::quantile(dist, 1.0 - (1.0 - options.conf_level) / 2.0) * e.standard_error;
+    } else {
+      const bm::normal_distribution<double> normal;
+      e.p_value = 2.0 * bm::cdf(bm::complement(normal, std::abs(e.t)));
+      half = bm::quantile(normal, 1.0 - (1.0 - options.conf_level) / 2.0) * e.standard_error;
+    }
+    e.conf_int = {e.estimate - half, e.estimate + half, options.conf_level};
+    r.fixed_effects.push_back(e);
+  }
+
   // Contrast of the take effect: lmerTest uses type I contrasts for a model with one term (its
   // type III reduces to them), the rows of t(doolittle(X'X)$L) of the take columns.
   r.contrast = DoolittleL(d.xtx).transpose().bottomRows(p - 1);
@@ -467,11 +513,7 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
     const Eigen::RowVectorXd direction = vl_eigen.eigenvectors().col(idx).transpose() * r.contrast;
     const double estimate = direction.dot(r.beta);
     t2_sum += estimate * estimate / value;
-    const Eigen::Vector2d gradient(direction * jac_theta * direction.transpose(),
-                                   direction * jac_sigma * direction.transpose());
-    const double variance = gradient.dot(varpar_covariance * gradient);
-    r.direction_df.push_back(variance > 0.0 ? 2.0 * value * value / variance
-                                            : std::numeric_limits<double>::infinity());
+    r.direction_df.push_back(satterthwaite(direction, value));
   }
   const double q = static_cast<double>(r.direction_df.size());
   const double f = t2_sum / q;

@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include "study/htest.h"
+
 namespace mmh::study {
 
 struct MixedModelOptions {
@@ -30,11 +32,14 @@ struct MixedModelOptions {
   double hessian_tolerance = 1e-8;
   // Grid points per decade of psi in [1e-10, 1e10] on which the REML score is bracketed.
   int grid_points_per_decade = 4;
+  // Coverage of the fixed effects' confidence intervals (lmerTest's contest1D level).
+  double conf_level = 0.95;
 
   template <class V>
   void VisitFields(V& v) {
     v("hessian_tolerance", hessian_tolerance);
     v("grid_points_per_decade", grid_points_per_decade);
+    v("conf_level", conf_level);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -49,6 +54,20 @@ struct FTest {
   double mean_sq = 0.0;  // sum_sq / num_df
   // Partial eta squared from F: F num_df / (F num_df + den_df).
   double partial_eta_squared = 0.0;
+
+  nlohmann::json ToJson() const;
+};
+
+// One fixed effect with its Satterthwaite t test and Wald interval (lmerTest's summary() row and
+// contest1D(confint = TRUE)).
+struct FixedEffect {
+  std::string name;  // "(Intercept)", then "take2", "take3", ... (level j + 1 minus level 1)
+  double estimate = 0.0;
+  double standard_error = 0.0;
+  double df = 0.0;
+  double t = 0.0;
+  double p_value = 0.0;  // two-sided
+  ConfidenceInterval conf_int;
 
   nlohmann::json ToJson() const;
 };
@@ -77,8 +96,9 @@ struct MixedModelResult {
   // lme4's REMLcrit: -2 times the restricted log-likelihood at the optimum.
   double reml_criterion = 0.0;
   // Fixed effects in treatment coding: (Intercept) = mean of level 0, then level j - level 0.
-  Eigen::VectorXd beta;             // #levels
-  Eigen::MatrixXd beta_covariance;  // #levels by #levels (lme4's vcov)
+  Eigen::VectorXd beta;                    // #levels
+  Eigen::MatrixXd beta_covariance;         // #levels by #levels (lme4's vcov)
+  std::vector<FixedEffect> fixed_effects;  // one per entry of beta, same order
   // lmerTest: the contrast matrix of the test (type I = III for one factor), the per-direction
   // Satterthwaite df and the F test.
   Eigen::MatrixXd contrast;  // (#levels - 1) by #levels

@@ -404,6 +404,18 @@ std::string StudyAnalysis::TestsCsv() const {
     const double n = static_cast<double>(m->summary.observations);
     out += TestRowCsv(FRow("h3", "mixed model F (Satterthwaite)", m->take_test, n));
     if (m->rm_anova) out += TestRowCsv(FRow("h3", "repeated-measures ANOVA F", *m->rm_anova, n));
+    // The take differences (fixed effects after the intercept): take j minus take 1.
+    for (std::size_t j = 1; j < m->fixed_effects.size(); ++j) {
+      const FixedEffect& e = m->fixed_effects[j];
+      TestRow row{"h3", "mixed model t (Satterthwaite) " + e.name + " - take1", "t", e.t, e.df};
+      row.p_value = e.p_value;
+      row.estimate = e.estimate;
+      row.conf_low = e.conf_int.lower;
+      row.conf_high = e.conf_int.upper;
+      row.conf_level = e.conf_int.level;
+      row.n = n;
+      out += TestRowCsv(row);
+    }
   }
   if (h3.residual_normality.result) {
     out += TestRowCsv(ShapiroRow("h3", *h3.residual_normality.result));

@@ -173,6 +173,18 @@ add_shapiro("constant", rep(2, 5))
 
 # ---- mixed model (H3) ----
 mixed_cases <- list()
+# lmerTest's summary() coefficient rows with contest1D's 95% Wald interval (Satterthwaite df).
+fixed_effects <- function(m) {
+  p <- length(fixef(m))
+  lapply(seq_len(p), function(j) {
+    l <- numeric(p)
+    l[j] <- 1
+    r <- contest1D(m, l, confint = TRUE, level = 0.95)
+    list(estimate = num(r$Estimate), standard_error = num(r[["Std. Error"]]), df = num(r$df),
+         t = num(r[["t value"]]), p_value = num(r[["Pr(>|t|)"]]), lower = num(r$lower),
+         upper = num(r$upper))
+  })
+}
 add_mixed <- function(name, animator, take, y) {
   d <- data.frame(animator = factor(animator), take = factor(take), y = y)
   fit <- fit_refined(d)
@@ -186,6 +198,23 @@ add_mixed <- function(name, animator, take, y) {
                den_df = num(within$Df[2]), p_value = num(within[["Pr(>F)"]][1]),
                sum_sq = num(within[["Sum Sq"]][1]))
   }
+  # Balanced and sigma_a^2 > 0: the intercept (mean of take 1) has variance (MS_A + (k - 1) MS_E)
+  # / (k n), whose classic Satterthwaite df are exact; lmerTest's numerical derivatives approach
+  # them to ~1e-10.
+  intercept_exact <- NULL
+  if (balanced && fit$theta > 0) {
+    s <- summary(aov(y ~ take + Error(animator / take), data = d))
+    ms_a <- s[["Error: animator"]][[1]][["Mean Sq"]][1]
+    ms_e <- s[["Error: animator:take"]][[1]][["Mean Sq"]][2]
+    k <- nlevels(d$take)
+    n <- nlevels(d$animator)
+    df <- (ms_a + (k - 1) * ms_e)^2 / (ms_a^2 / (n - 1) + ((k - 1) * ms_e)^2 / ((n - 1) * (k - 1)))
+    est <- num(fixef(m)[1])
+    se <- sqrt(num(vcov(m)[1, 1]))
+    q <- qt(0.975, df)
+    intercept_exact <- list(df = df, p_value = 2 * pt(-abs(est / se), df), lower = est - q * se,
+                            upper = est + q * se)
+  }
   res_sw <- shapiro.test(residuals(m))
   mixed_cases[[length(mixed_cases) + 1]] <<- list(
     name = name, animator = vec(as.integer(d$animator) - 1L), take = vec(as.integer(d$take) - 1L),
@@ -193,6 +222,7 @@ add_mixed <- function(name, animator, take, y) {
     theta_default = num(getME(fit$m0, "theta")), theta = num(getME(m, "theta")),
     sigma = num(sigma(m)), beta = vec(fixef(m)), vcov = as.matrix(vcov(m)),
     reml_criterion = num(REMLcrit(m)), anova = anova_row(m), anova_default = anova_row(fit$m0),
+    coefficients = fixed_effects(m), intercept_exact = intercept_exact,
     ranef = vec(ranef(m)$animator[, 1]), residuals = vec(residuals(m)),
     residual_shapiro = list(w = num(res_sw$statistic), p_value = num(res_sw$p.value)),
     rm_anova = rm)
