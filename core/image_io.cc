@@ -100,6 +100,16 @@ fs::path TemporaryBeside(const fs::path& path) {
   return temporary;
 }
 
+OIIO::ImageSpec PngSpec(int width, int height, int channels, OIIO::TypeDesc format,
+                        int compression) {
+  if (compression < 0 || compression > 9) {
+    ThrowBadValue("PNG compression", std::to_string(compression), "a zlib level in [0, 9]");
+  }
+  OIIO::ImageSpec spec(width, height, channels, format);
+  spec.attribute("png:compressionLevel", compression);
+  return spec;
+}
+
 // Writes one image through OpenImageIO to a temporary file, then renames it over `path`.
 void WriteImageAtomically(const fs::path& path, const OIIO::ImageSpec& spec, const void* pixels) {
   const fs::path temporary = TemporaryBeside(path);
@@ -225,14 +235,15 @@ DepthImage ReadDepthPng16(const fs::path& path) {
   return image;
 }
 
-void WriteDepthPng16(const fs::path& path, const DepthImage& image) {
+void WriteDepthPng16(const fs::path& path, const DepthImage& image, int compression) {
   RequireSize(path, image.width, image.height);
   const size_t expected = static_cast<size_t>(image.width) * image.height;
   if (image.values.size() != expected) {
     ThrowBadValue(path.string() + ", depth values", std::to_string(image.values.size()),
                   std::to_string(expected) + " = width x height");
   }
-  WriteImageAtomically(path, OIIO::ImageSpec(image.width, image.height, 1, OIIO::TypeDesc::UINT16),
+  WriteImageAtomically(path,
+                       PngSpec(image.width, image.height, 1, OIIO::TypeDesc::UINT16, compression),
                        image.values.data());
 }
 
@@ -267,14 +278,15 @@ RgbImage ReadRgbImage(const fs::path& path) {
   return image;
 }
 
-void WriteRgbPng(const fs::path& path, const RgbImage& image) {
+void WriteRgbPng(const fs::path& path, const RgbImage& image, int compression) {
   RequireSize(path, image.width, image.height);
   const size_t expected = static_cast<size_t>(image.width) * image.height * 3;
   if (image.rgb.size() != expected) {
     ThrowBadValue(path.string() + ", rgb bytes", std::to_string(image.rgb.size()),
                   std::to_string(expected) + " = width x height x 3");
   }
-  WriteImageAtomically(path, OIIO::ImageSpec(image.width, image.height, 3, OIIO::TypeDesc::UINT8),
+  WriteImageAtomically(path,
+                       PngSpec(image.width, image.height, 3, OIIO::TypeDesc::UINT8, compression),
                        image.rgb.data());
 }
 

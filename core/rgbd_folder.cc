@@ -217,6 +217,10 @@ std::vector<ListEntry> ReadList(const fs::path& path) {
 }  // namespace
 
 void RgbdCameraInfo::Validate(const std::string& prefix) const {
+  if (png_compression < 0 || png_compression > 9) {
+    ThrowBadValue(prefix + ": png_compression", std::to_string(png_compression),
+                  "a zlib level in [0, 9]");
+  }
   depth_intrinsics.Validate(prefix + ": depth_intrinsics");
   color_intrinsics.Validate(prefix + ": color_intrinsics");
   if (!std::isfinite(depth_scale) || depth_scale <= 0) {
@@ -378,8 +382,10 @@ void RgbdFolderWriter::Add(const RgbdFrame& frame) {
                         " is taken)");
     }
   }
-  WriteDepthPng16(staging() / "depth" / name, DepthImage{di.width, di.height, frame.depth});
-  WriteRgbPng(staging() / "rgb" / name, RgbImage{ci.width, ci.height, frame.rgb});
+  WriteDepthPng16(staging() / "depth" / name, DepthImage{di.width, di.height, frame.depth},
+                  camera_.png_compression);
+  WriteRgbPng(staging() / "rgb" / name, RgbImage{ci.width, ci.height, frame.rgb},
+              camera_.png_compression);
   std::lock_guard<std::mutex> lock(shared_->mutex);
   shared_->entries.emplace_back(frame.timestamp, name);
 }

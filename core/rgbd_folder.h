@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/image_io.h"
 #include "core/rgbd_frame.h"
 #include "core/rigid3.h"
 #include "core/trajectory.h"
@@ -42,6 +43,9 @@ struct RgbdCameraInfo {
   // Free-form description of the sensor (e.g. the Kinect calibration and noise options); an
   // object or null.
   nlohmann::json sensor = nlohmann::json::object();
+  // zlib level of the PNGs a writer makes (not stored in camera.json): 1 writes about 3.5 times
+  // faster than the default 6 for files 5-15 % larger; the pixels are the same.
+  int png_compression = kDefaultPngCompression;
 
   // Intrinsics valid, depth_scale finite and > 0, unit quaternion; InputError naming `prefix`.
   void Validate(const std::string& prefix) const;

@@ -1,7 +1,11 @@
 #include "sim/render_session.h"
 
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -131,6 +135,10 @@ void RenderOptions::Validate(const std::string& prefix) const {
     if (value < 0 || value > 100000) {
       ThrowBadValue(prefix + "." + name, std::to_string(value), "an index in [0, 100000]");
     }
+  }
+  if (png_compression < 0 || png_compression > 9) {
+    ThrowBadValue(prefix + ".png_compression", std::to_string(png_compression),
+                  "a zlib level in [0, 9]");
   }
   if (!story.empty() && !EndsWith(story, ".json")) {
     ThrowBadValue(prefix + ".story", "\"" + story + "\"", "a story file (.json), or empty");
@@ -389,8 +397,23 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
   // Read and check every input before the first frame.
   const Motion motion = ResolveMotion(config);
   const TriangleMesh proxy_model = LoadProxyModel(motion.proxy, r.proxy_scale);
-  TableTopScene table_top(config, proxy_model);
-  KinectSensor sensor(config.sensor, &table_top.scene(), table_top.table_T_camera());
+  // One scene and sensor per thread: frames render in parallel (RenderFrames) and come back in
+  // order; their PNGs are encoded in parallel too. The bytes do not depend on the thread count.
+  const int threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  std::vector<std::unique_ptr<TableTopScene>> scenes;
+  std::vector<std::unique_ptr<KinectSensor>> sensors;
+  std::vector<SensorWorker> workers;
+  for (int w = 0; w < std::min(threads, motion.frames); ++w) {
+    scenes.push_back(std::make_unique<TableTopScene>(config, proxy_model));
+    sensors.push_back(std::make_unique<KinectSensor>(config.sensor, &scenes.back()->scene(),
+                                                     scenes.back()->table_T_camera()));
+    TableTopScene* scene = scenes.back().get();
+    workers.push_back({[scene, &motion](int i) {
+                         scene->SetFrame(motion.table_T_proxy[i], motion.slider[i], motion.hand);
+                       },
+                       sensors.back().get()});
+  }
+  const KinectSensor& sensor = *sensors.front();
   const Rigid3 depth_T_table = sensor.world_T_depth_camera().Inverse();
 
   RgbdCameraInfo camera;
@@ -402,40 +425,52 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
                    {"registered", config.sensor.registered},
                    {"calibration", mmh::ToJson(config.sensor.calibration)},
                    {"seed", config.sensor.seed}};
+  camera.png_compression = r.png_compression;
   RgbdFolderWriter writer(out, camera);
   std::unique_ptr<FakenectWriter> fakenect;
   if (r.fakenect) fakenect = std::make_unique<FakenectWriter>(out.string() + ".fakenect");
 
   RenderSummary summary;
-  RgbdFrame frame;
   Trajectory groundtruth;
   Annotation slider_truth;
   BopFrames bop;
   double missing_sum = 0.0;
-  for (int i = 0; i < motion.frames; ++i) {
-    const Rigid3& table_T_proxy = motion.table_T_proxy[i];
-    const double slider = motion.slider[i];
-    const auto t0 = Clock::now();
-    table_top.SetFrame(table_T_proxy, slider, motion.hand);
-    sensor.Render(i, r.mode, &frame);
-    const auto t1 = Clock::now();
-    writer.Add(frame);
+  std::atomic<std::int64_t> write_nanoseconds{0};
+  tbb::task_group writes;
+  int pending = 0;
+  const auto start = Clock::now();
+  RenderFrames(workers, 0, motion.frames, r.mode, [&](const RgbdFrame& frame) {
+    const int i = frame.index;
     if (fakenect) {
       fakenect->Add(frame.timestamp, RawDisparityFromDepth(frame, config.sensor.calibration),
                     frame.rgb);
     }
-    summary.write_seconds += std::chrono::duration<double>(Clock::now() - t1).count();
-    summary.seconds += std::chrono::duration<double>(t1 - t0).count();
-    const Rigid3 camera_T_proxy = depth_T_table * table_T_proxy;
+    const Rigid3 camera_T_proxy = depth_T_table * motion.table_T_proxy[i];
     groundtruth.timestamps.push_back(frame.timestamp);
     groundtruth.poses.push_back(camera_T_proxy);
     slider_truth.timestamps.push_back(frame.timestamp);
-    slider_truth.values.push_back(std::clamp(slider, -5.0, 5.0));
+    slider_truth.values.push_back(std::clamp(motion.slider[i], -5.0, 5.0));
     bop.push_back({BopObjectPose{1, camera_T_proxy}});
     missing_sum += static_cast<double>(std::count(frame.depth.begin(), frame.depth.end(), 0)) /
                    frame.depth.size();
+    // Encoding a frame's PNGs takes longer than rendering it: hand it to another thread, with a
+    // bounded number of frames in flight.
+    if (pending == 2 * threads) {
+      writes.wait();
+      pending = 0;
+    }
+    ++pending;
+    writes.run([&writer, &write_nanoseconds, copy = frame] {
+      const auto t0 = Clock::now();
+      writer.Add(copy);
+      write_nanoseconds +=
+          std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+    });
     if (progress) progress(i + 1, motion.frames);
-  }
+  });
+  writes.wait();
+  summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.write_seconds = 1e-9 * static_cast<double>(write_nanoseconds.load());
   summary.frames = motion.frames;
   summary.missing_fraction = missing_sum / motion.frames;
   if (motion.take) {
@@ -445,7 +480,7 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
                     {"flaws", motion.take->flaws.size()}};
     if (motion.annotation) summary.take["clipped_fraction"] = motion.annotation->clipped_fraction;
   }
-  summary.timings = sensor.timings();
+  summary.timings = TotalTimings(workers);
 
   // The setup's calibration, for the tracker: where the camera stands and where the Like box is.
   nlohmann::json scene_json;
