@@ -63,13 +63,19 @@ std::string TestRowCsv(const TestRow& r) {
          r.effect_size_name + "," + Number(r.effect_size) + "," + Number(r.n) + "\n";
 }
 
+// Sets the p-value, the estimate and its interval of `row`.
+TestRow& SetEstimate(TestRow& row, double p_value, double estimate, const ConfidenceInterval& ci) {
+  row.p_value = p_value;
+  row.estimate = estimate;
+  row.conf_low = ci.lower;
+  row.conf_high = ci.upper;
+  row.conf_level = ci.level;
+  return row;
+}
+
 TestRow TRow(const std::string& analysis, const TTestResult& t) {
   TestRow row{analysis, "one-sample t-test", "t", t.t, t.df};
-  row.p_value = t.p_value;
-  row.estimate = t.mean;
-  row.conf_low = t.conf_int.lower;
-  row.conf_high = t.conf_int.upper;
-  row.conf_level = t.conf_int.level;
+  SetEstimate(row, t.p_value, t.mean, t.conf_int);
   row.effect_size_name = "cohens_d";
   row.effect_size = t.cohens_d;
   row.n = static_cast<double>(t.n);
@@ -87,11 +93,7 @@ TestRow FriedmanRow(const FriedmanResult& f) {
 
 TestRow BinomialRow(const std::string& analysis, const BinomialTestResult& b) {
   TestRow row{analysis, "exact binomial test", "successes", static_cast<double>(b.successes)};
-  row.p_value = b.p_value;
-  row.estimate = b.estimate;
-  row.conf_low = b.conf_int.lower;
-  row.conf_high = b.conf_int.upper;
-  row.conf_level = b.conf_int.level;
+  SetEstimate(row, b.p_value, b.estimate, b.conf_int);
   row.effect_size_name = "cohens_h";
   row.effect_size = b.cohens_h;
   row.n = static_cast<double>(b.trials);
@@ -408,12 +410,7 @@ std::string StudyAnalysis::TestsCsv() const {
     for (std::size_t j = 1; j < m->fixed_effects.size(); ++j) {
       const FixedEffect& e = m->fixed_effects[j];
       TestRow row{"h3", "mixed model t (Satterthwaite) " + e.name + " - take1", "t", e.t, e.df};
-      row.p_value = e.p_value;
-      row.estimate = e.estimate;
-      row.conf_low = e.conf_int.lower;
-      row.conf_high = e.conf_int.upper;
-      row.conf_level = e.conf_int.level;
-      row.n = n;
+      SetEstimate(row, e.p_value, e.estimate, e.conf_int).n = n;
       out += TestRowCsv(row);
     }
   }
