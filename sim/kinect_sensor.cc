@@ -233,10 +233,12 @@ inline uint32_t CounterHash(uint32_t key, uint32_t counter) {
 // Box-Muller (1958) from a 32-bit hash: radius sqrt(-2 ln u1) with u1 = (bits 16-31 + 1/2) / 2^16
 // (tails to 4.85 sigma), angle q pi/2 + x with the quadrant q = bits 14-15 and x uniform in
 // (-pi/4, pi/4) from bits 0-13. Returns the two independent standard normals r cos and r sin.
-// ln, sin and cos are evaluated here with IEEE operations only (no libm, whose vector variants
-// may round differently): ln m = 2 atanh((m - 1) / (m + 1)) on m in [sqrt(1/2), sqrt(2)) (series
-// to s^9, error < 1e-9), sin and cos by their Taylor series to x^9 and x^10 on |x| <= pi/4
-// (error < 3e-10). The AVX-512 kernels repeat these operations in the same order.
+// ln, sin and cos are evaluated here with IEEE operations only (+, *, /, sqrt and fused
+// multiply-add, all correctly rounded; no libm approximations, whose vector variants may round
+// differently): ln m = 2 atanh((m - 1) / (m + 1)) on m in [sqrt(1/2), sqrt(2)) (series to s^9,
+// error < 1e-9), sin and cos by their Taylor series to x^9 and x^10 on |x| <= pi/4 (error
+// < 3e-10), Horner steps as std::fma. The AVX-512 kernels repeat these operations in the same
+// order (std::fma and vfmadd round alike).
 constexpr float kLn2 = 0.693147180559945309f;
 constexpr float kSqrtHalf = 0.707106781186547524f;
 constexpr float kSqrt2 = 1.41421356237309505f;
@@ -251,8 +253,11 @@ inline float LnUnit(float u) {
   e = high ? e + 1 : e;
   const float s = (m - 1.0f) / (m + 1.0f);
   const float s2 = s * s;
-  const float series = 1.0f + s2 * (1.0f / 3 + s2 * (1.0f / 5 + s2 * (1.0f / 7 + s2 * (1.0f / 9))));
-  return static_cast<float>(e) * kLn2 + 2.0f * s * series;
+  float series = std::fma(s2, 1.0f / 9, 1.0f / 7);
+  series = std::fma(s2, series, 1.0f / 5);
+  series = std::fma(s2, series, 1.0f / 3);
+  series = std::fma(s2, series, 1.0f);
+  return std::fma(static_cast<float>(e), kLn2, (2.0f * s) * series);
 }
 
 inline void BoxMuller(uint32_t h, float* c, float* s) {
@@ -262,12 +267,15 @@ inline void BoxMuller(uint32_t h, float* c, float* s) {
   const float t = (static_cast<float>(static_cast<int>(h & 0x3fffu)) + 0.5f) * (1.0f / 16384.0f);
   const float x = (t - 0.5f) * kHalfPi;
   const float x2 = x * x;
-  const float sin_x =
-      x + x * x2 * (-1.0f / 6 + x2 * (1.0f / 120 + x2 * (-1.0f / 5040 + x2 * (1.0f / 362880))));
-  const float cos_x =
-      1.0f +
-      x2 * (-1.0f / 2 +
-            x2 * (1.0f / 24 + x2 * (-1.0f / 720 + x2 * (1.0f / 40320 + x2 * (-1.0f / 3628800)))));
+  float sin_x = std::fma(x2, 1.0f / 362880, -1.0f / 5040);
+  sin_x = std::fma(x2, sin_x, 1.0f / 120);
+  sin_x = std::fma(x2, sin_x, -1.0f / 6);
+  sin_x = std::fma(x * x2, sin_x, x);
+  float cos_x = std::fma(x2, -1.0f / 3628800, 1.0f / 40320);
+  cos_x = std::fma(x2, cos_x, -1.0f / 720);
+  cos_x = std::fma(x2, cos_x, 1.0f / 24);
+  cos_x = std::fma(x2, cos_x, -1.0f / 2);
+  cos_x = std::fma(x2, cos_x, 1.0f);
   // (cos, sin) of q pi/2 + x.
   const float a = (q & 1u) ? sin_x : cos_x;
   const float b = (q & 1u) ? cos_x : sin_x;
@@ -293,8 +301,9 @@ inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, 
   // Pixels that see nothing get a harmless depth so that the arithmetic stays finite.
   z = keep ? z : 1.0f;
   const float dz = z - q.axial_z0;
-  const float sigma = q.axial_a + q.axial_b * dz * dz + q.grazing_sigma[step] / std::sqrt(z);
-  const float zn = z + sigma * g;
+  const float sigma =
+      std::fma(q.axial_b * dz, dz, q.axial_a) + q.grazing_sigma[step] / std::sqrt(z);
+  const float zn = std::fma(sigma, g, z);
   const float raw = std::floor(q.raw_offset - q.lattice / zn + 0.5f);
   const float zq = q.lattice / (q.raw_offset - raw);
   // Selections written so that GCC if-converts them (the loop must vectorise).
@@ -312,8 +321,8 @@ inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, 
 // The random numbers of the depth pixels [first_pixel, first_pixel + n): pixels 2k and 2k + 1 take
 // the two normals of the Box-Muller pair of counter k (key_c) and the low and high 16 bits of the
 // key_b hash of k as their dropout uniforms.
-void DepthNoisePortable(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
-                        float* normal) {
+MMH_SIMD_CLONES void DepthNoisePortable(const DepthParams& q, uint32_t first_pixel, int n,
+                                        uint32_t* drop_bits, float* normal) {
   for (int i = 0; i < n;) {
     const uint32_t pixel = first_pixel + static_cast<uint32_t>(i);
     const uint32_t pair = pixel >> 1;
@@ -345,10 +354,11 @@ inline uint16_t DepthPixel(const DepthParams& q, float left, float d, float righ
 
 // A row of DepthPixel (outside the image counts as equal: no jump).
 template <bool kQuantise>
-void DepthRowPortable(const DepthParams& q, const float* up, const float* row, const float* down,
-                      const float* depth, const float* cos_incidence, const uint8_t* occluded,
-                      const uint32_t* drop_bits, const float* normal, int first, int n,
-                      uint8_t* edge, uint16_t* out) {
+MMH_SIMD_CLONES void DepthRowPortable(const DepthParams& q, const float* up, const float* row,
+                                      const float* down, const float* depth,
+                                      const float* cos_incidence, const uint8_t* occluded,
+                                      const uint32_t* drop_bits, const float* normal, int first,
+                                      int n, uint8_t* edge, uint16_t* out) {
   for (int i = first; i < n; ++i) {
     const float left = i > 0 ? row[i - 1] : row[i];
     const float right = i + 1 < n ? row[i + 1] : row[i];
@@ -361,8 +371,8 @@ void DepthRowPortable(const DepthParams& q, const float* up, const float* row, c
 // One colour byte: value + sigma g, rounded and clamped.
 inline uint8_t NoisyColor(const ColorParams& p, uint8_t value, float g) {
   const float v = static_cast<float>(value);
-  const float sigma = std::sqrt(p.read2 + p.gain * v);
-  float noisy = std::floor(v + sigma * g + 0.5f);
+  const float sigma = std::sqrt(std::fma(p.gain, v, p.read2));
+  float noisy = std::floor(std::fma(sigma, g, v) + 0.5f);
   noisy = noisy > 255.0f ? 255.0f : noisy;
   noisy = noisy < 0.0f ? 0.0f : noisy;
   return static_cast<uint8_t>(static_cast<int>(noisy));
@@ -370,8 +380,8 @@ inline uint8_t NoisyColor(const ColorParams& p, uint8_t value, float g) {
 
 // Colour noise on n bytes (RGB interleaved) of a row: bytes 2k and 2k + 1 take the two normals of
 // the Box-Muller pair of counter first_counter + k.
-void ColorRowPortable(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
-                      uint8_t* out) {
+MMH_SIMD_CLONES void ColorRowPortable(const ColorParams& p, const uint8_t* in,
+                                      uint32_t first_counter, int n, uint8_t* out) {
   for (int k = 0; 2 * k < n; ++k) {
     float c, s;
     BoxMuller(CounterHash(p.key, first_counter + static_cast<uint32_t>(k)), &c, &s);
@@ -415,6 +425,8 @@ MMH_AVX512 inline __m512 AbsDiff(__m512 a, __m512 b) { return _mm512_abs_ps(_mm5
 MMH_AVX512 inline __m512 Set(float x) { return _mm512_set1_ps(x); }
 MMH_AVX512 inline __m512 Add(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
 MMH_AVX512 inline __m512 Mul(__m512 a, __m512 b) { return _mm512_mul_ps(a, b); }
+// a b + c rounded once, as std::fma in the portable kernels.
+MMH_AVX512 inline __m512 Fma(__m512 a, __m512 b, __m512 c) { return _mm512_fmadd_ps(a, b, c); }
 // Low 16 / bits 0-13 of h as floats.
 MMH_AVX512 inline __m512 BitsToFloat(__m512i h, int mask) {
   return _mm512_cvtepi32_ps(_mm512_and_si512(h, _mm512_set1_epi32(mask)));
@@ -430,12 +442,11 @@ MMH_AVX512 inline __m512 LnUnitx16(__m512 u) {
   e = _mm512_mask_add_epi32(e, high, e, _mm512_set1_epi32(1));
   const __m512 s = _mm512_div_ps(_mm512_sub_ps(m, Set(1.0f)), Add(m, Set(1.0f)));
   const __m512 s2 = Mul(s, s);
-  const __m512 series = Add(
-      Set(1.0f),
-      Mul(s2,
-          Add(Set(1.0f / 3),
-              Mul(s2, Add(Set(1.0f / 5), Mul(s2, Add(Set(1.0f / 7), Mul(s2, Set(1.0f / 9)))))))));
-  return Add(Mul(_mm512_cvtepi32_ps(e), Set(kLn2)), Mul(Mul(Set(2.0f), s), series));
+  __m512 series = Fma(s2, Set(1.0f / 9), Set(1.0f / 7));
+  series = Fma(s2, series, Set(1.0f / 5));
+  series = Fma(s2, series, Set(1.0f / 3));
+  series = Fma(s2, series, Set(1.0f));
+  return Fma(_mm512_cvtepi32_ps(e), Set(kLn2), Mul(Mul(Set(2.0f), s), series));
 }
 
 MMH_AVX512 inline void BoxMullerx16(__m512i h, __m512* c, __m512* s) {
@@ -446,18 +457,15 @@ MMH_AVX512 inline void BoxMullerx16(__m512i h, __m512* c, __m512* s) {
   const __m512 t = Mul(Add(BitsToFloat(h, 0x3fff), Set(0.5f)), Set(1.0f / 16384.0f));
   const __m512 x = Mul(_mm512_sub_ps(t, Set(0.5f)), Set(kHalfPi));
   const __m512 x2 = Mul(x, x);
-  const __m512 sin_x =
-      Add(x, Mul(Mul(x, x2),
-                 Add(Set(-1.0f / 6),
-                     Mul(x2, Add(Set(1.0f / 120),
-                                 Mul(x2, Add(Set(-1.0f / 5040), Mul(x2, Set(1.0f / 362880)))))))));
-  const __m512 cos_x =
-      Add(Set(1.0f),
-          Mul(x2, Add(Set(-1.0f / 2),
-                      Mul(x2, Add(Set(1.0f / 24),
-                                  Mul(x2, Add(Set(-1.0f / 720),
-                                              Mul(x2, Add(Set(1.0f / 40320),
-                                                          Mul(x2, Set(-1.0f / 3628800)))))))))));
+  __m512 sin_x = Fma(x2, Set(1.0f / 362880), Set(-1.0f / 5040));
+  sin_x = Fma(x2, sin_x, Set(1.0f / 120));
+  sin_x = Fma(x2, sin_x, Set(-1.0f / 6));
+  sin_x = Fma(Mul(x, x2), sin_x, x);
+  __m512 cos_x = Fma(x2, Set(-1.0f / 3628800), Set(1.0f / 40320));
+  cos_x = Fma(x2, cos_x, Set(-1.0f / 720));
+  cos_x = Fma(x2, cos_x, Set(1.0f / 24));
+  cos_x = Fma(x2, cos_x, Set(-1.0f / 2));
+  cos_x = Fma(x2, cos_x, Set(1.0f));
   const __mmask16 odd = _mm512_test_epi32_mask(q, _mm512_set1_epi32(1));
   const __m512 a = _mm512_mask_blend_ps(odd, cos_x, sin_x);
   const __m512 b = _mm512_mask_blend_ps(odd, sin_x, cos_x);
@@ -530,7 +538,7 @@ MMH_AVX512 inline void DepthBlockAvx512(const DepthParams& q, const float* up, c
       Mul(_mm512_cvtepi32_ps(_mm512_loadu_si512(drop_bits + i)), Set(1.0f / 65536.0f));
   const __m512 z = _mm512_mask_blend_ps(keep, Set(1.0f), _mm512_loadu_ps(depth + i));
   const __m512 dz = _mm512_sub_ps(z, Set(q.axial_z0));
-  __m512 sigma = Add(Set(q.axial_a), Mul(Mul(Set(q.axial_b), dz), dz));
+  __m512 sigma = Fma(Mul(Set(q.axial_b), dz), dz, Set(q.axial_a));
   __m512 drop = Set(q.drop[kCosSteps]);
   // Steps from q.flat_step on have no grazing term (it is exactly 0, adding it changes nothing)
   // and the dropout probability of the last step: no table lookups when all lanes are there.
@@ -539,7 +547,7 @@ MMH_AVX512 inline void DepthBlockAvx512(const DepthParams& q, const float* up, c
         Add(sigma, _mm512_div_ps(_mm512_i32gather_ps(step, q.grazing_sigma, 4), _mm512_sqrt_ps(z)));
     drop = _mm512_i32gather_ps(step, q.drop, 4);
   }
-  const __m512 zn = Add(z, Mul(sigma, g));
+  const __m512 zn = Fma(sigma, g, z);
   __m512 zo = zn;
   __mmask16 valid = keep;
   if constexpr (kQuantise) {
@@ -589,10 +597,10 @@ MMH_AVX512 inline void NoisyColorx16(const ColorParams& p, const uint8_t* in, __
                                      uint8_t* out) {
   const __m512 v = _mm512_cvtepi32_ps(
       _mm512_cvtepu8_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(in))));
-  const __m512 sigma = _mm512_sqrt_ps(Add(Set(p.read2), Mul(Set(p.gain), v)));
+  const __m512 sigma = _mm512_sqrt_ps(Fma(Set(p.gain), v, Set(p.read2)));
   // floor, then noisy > 255 ? 255 : noisy, then noisy < 0 ? 0 : noisy, in integers (the sum is
   // finite and far inside the int range): the same bytes as the float clamps of NoisyColor.
-  const __m512i noisy = _mm512_cvt_roundps_epi32(Add(Add(v, Mul(sigma, g)), Set(0.5f)),
+  const __m512i noisy = _mm512_cvt_roundps_epi32(Add(Fma(sigma, g, v), Set(0.5f)),
                                                  _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
   const __m512i clamped =
       _mm512_max_epi32(_mm512_min_epi32(noisy, _mm512_set1_epi32(255)), _mm512_setzero_si512());
