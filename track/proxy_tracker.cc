@@ -363,6 +363,31 @@ ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
   return score;
 }
 
+void ProxyTracker::PrepareData() {
+  // ICP data: the segmented points evenly subsampled, then the skin points.
+  data_.clear();
+  const size_t stride =
+      std::max<size_t>(1, (segmentation_.points.size() + options_.verification.max_points - 1) /
+                              options_.verification.max_points);
+  for (size_t i = 0; i < segmentation_.points.size(); i += stride) {
+    data_.push_back(segmentation_.points[i]);
+  }
+  scored_ = data_.size();
+  // Skin points only within reach of the proxy (the segmented points' centroid plus the model's
+  // radius and the ICP's start distance): most of the hand and forearm can never lie on the model
+  // and would only cost time in every ICP iteration.
+  if (scored_ > 0) {
+    Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+    for (size_t i = 0; i < scored_; ++i) centroid += data_[i];
+    centroid /= static_cast<float>(scored_);
+    const float reach = model_->radius() + static_cast<float>(options_.icp.start_distance);
+    for (size_t i = 0; i < segmentation_.skin_points.size(); i += stride) {
+      const Eigen::Vector3f& p = segmentation_.skin_points[i];
+      if ((p - centroid).squaredNorm() <= reach * reach) data_.push_back(p);
+    }
+  }
+}
+
 TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   TrackFrameResult result;
   result.index = frame.index;
@@ -413,29 +438,19 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   segmenter_.Segment(frame, &segmentation_, predicted ? &window : nullptr);
   result.points = static_cast<int>(segmentation_.points.size());
   result.skin_points = static_cast<int>(segmentation_.skin_points.size());
-  // ICP data: the segmented points evenly subsampled, then the skin points.
-  data_.clear();
-  const size_t stride =
-      std::max<size_t>(1, (segmentation_.points.size() + options_.verification.max_points - 1) /
-                              options_.verification.max_points);
-  for (size_t i = 0; i < segmentation_.points.size(); i += stride)
-    data_.push_back(segmentation_.points[i]);
-  scored_ = data_.size();
-  // Skin points only within reach of the proxy (the segmented points' centroid plus the model's
-  // radius and the ICP's start distance): most of the hand and forearm can never lie on the model
-  // and would only cost time in every ICP iteration.
-  if (scored_ > 0) {
-    Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
-    for (size_t i = 0; i < scored_; ++i) centroid += data_[i];
-    centroid /= static_cast<float>(scored_);
-    const float reach = model_->radius() + static_cast<float>(options_.icp.start_distance);
-    for (size_t i = 0; i < segmentation_.skin_points.size(); i += stride) {
-      const Eigen::Vector3f& p = segmentation_.skin_points[i];
-      if ((p - centroid).squaredNorm() <= reach * reach) data_.push_back(p);
-    }
-  }
+  PrepareData();
+  bool windowed = predicted.has_value();
+  // The detection looks at the whole play area: a jump may have left the window.
+  auto segment_whole_play_area = [&] {
+    if (!windowed) return;
+    windowed = false;
+    segmenter_.Segment(frame, &segmentation_, nullptr);
+    result.points = static_cast<int>(segmentation_.points.size());
+    result.skin_points = static_cast<int>(segmentation_.skin_points.size());
+    PrepareData();
+  };
 
-  const bool enough = result.points >= options_.verification.min_points;
+  bool enough = result.points >= options_.verification.min_points;
   std::optional<Candidate> chosen;
   if (predicted && enough) {
     const IcpResult icp =
@@ -459,13 +474,26 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
          candidate.free_space_violation > d.recheck_free_space ||
          (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
       frames_since_detection_ = 0;
+      if (windowed) {
+        // Compare on the same data: the whole play area.
+        segment_whole_play_area();
+        chosen = Verify(
+            frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                                     chosen->icp.proxy_T_camera, options_.icp));
+      }
       std::optional<Candidate> detected = Detect(frame, predicted);
-      if (detected && detected->good && detected->Score() > chosen->Score() + d.switch_margin) {
+      if (detected && detected->good &&
+          (!chosen->good || detected->Score() > chosen->Score() + d.switch_margin)) {
         chosen = detected;
         result.detected = true;
+      } else if (!chosen->good) {
+        why = chosen->reason;
+        chosen.reset();
       }
     }
   }
+  if (!chosen) segment_whole_play_area();
+  enough = result.points >= options_.verification.min_points;
   if (!chosen && enough) {
     std::optional<Candidate> detected = Detect(frame, predicted);
     frames_since_detection_ = 0;

@@ -186,6 +186,8 @@ class ProxyTracker {
  private:
   struct Candidate;
   bool EnsureTable(const RgbdFrame& frame, std::string* why);
+  // data_ and scored_ from segmentation_.
+  void PrepareData();
   // The global detection; `predicted` (the motion model's pose, when there is one) breaks ties.
   std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted);
   Candidate Verify(const RgbdFrame& frame, const IcpResult& icp) const;
