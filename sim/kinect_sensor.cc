@@ -719,6 +719,12 @@ void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, i
   ColorRowPortable(p, in, first_counter, n, out);
 }
 
+// f b / z of a packet's 16 lanes (lanes without a hit compute values nobody reads).
+MMH_SIMD_CLONES void DisparityLanes(const float* __restrict depth, float scale,
+                                    float* __restrict disparity) {
+  for (int i = 0; i < HitPacket::kLanes; ++i) disparity[i] = scale / depth[i];
+}
+
 // Occlusion scan values of one row for a light source at x = source (see the header):
 // u_s = u - shift * disparity; pixels that see nothing get `none` (never an extremum).
 MMH_SIMD_CLONES void SourceColumns(const float* __restrict disparity, int n, float shift,
@@ -837,6 +843,8 @@ struct KinectSensor::Impl {
       float* __restrict cos_incidence = cos_incidence_;
       uint8_t* __restrict color = color_;
       const float disparity_scale = s_.disparity_scale;
+      alignas(64) float lane_disparity[HitPacket::kLanes];
+      DisparityLanes(packet.depth, disparity_scale, lane_disparity);
       const uint32_t write = hits_only_ ? packet.hit : packet.cast;
       for (int r = 0; r < HitPacket::kTile; ++r) {
         const int shift = r * HitPacket::kTile;
@@ -845,11 +853,10 @@ struct KinectSensor::Impl {
         const size_t base = static_cast<size_t>(packet.v0 + r) * width_ + packet.u0;
         if (row_write == 0xfu && ((packet.hit >> shift) & 0xfu) == 0xfu) {
           // Four hits side by side (the common case).
-          for (int c = 0; c < HitPacket::kTile; ++c) {
-            depth[base + c] = packet.depth[shift + c];
-            disparity[base + c] = disparity_scale / packet.depth[shift + c];
-            cos_incidence[base + c] = packet.cos_incidence[shift + c];
-          }
+          std::memcpy(depth + base, packet.depth + shift, sizeof(float) * HitPacket::kTile);
+          std::memcpy(disparity + base, lane_disparity + shift, sizeof(float) * HitPacket::kTile);
+          std::memcpy(cos_incidence + base, packet.cos_incidence + shift,
+                      sizeof(float) * HitPacket::kTile);
           if (color != nullptr) {
             for (int c = 0; c < HitPacket::kTile; ++c) {
               s_.Shade(packet, shift + c, color + 3 * (base + c));
@@ -869,7 +876,7 @@ struct KinectSensor::Impl {
             continue;
           }
           depth[p] = packet.depth[i];
-          disparity[p] = disparity_scale / packet.depth[i];
+          disparity[p] = lane_disparity[i];
           cos_incidence[p] = packet.cos_incidence[i];
           if (color != nullptr) s_.Shade(packet, i, color + 3 * p);
         }

@@ -205,9 +205,9 @@ struct RayScene::Impl {
 
   // Builds a scene's BVH on one thread (see the constructor).
   void CommitScene(RTCScene scene) {
-    tbb::task_arena one_thread(1);
-    one_thread.execute([scene] { rtcCommitScene(scene); });
+    build_arena.execute([scene] { rtcCommitScene(scene); });
   }
+  tbb::task_arena build_arena{1};
 
   RTCScene NewScene() {
     RTCScene scene = rtcNewScene(device);
