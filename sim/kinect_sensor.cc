@@ -626,50 +626,56 @@ MMH_AVX512 void ColorRowAvx512(const ColorParams& p, const uint8_t* in, uint32_t
 // The occlusion scans of OccludeRow, 16 pixels at a time: exclusive suffix minima (prefix
 // maxima) inside a block by four shifted min (max) steps, carried across blocks. min and max are
 // exact, so the flags equal the scalar scan's. n: a multiple of 16 (us padded with `none`).
-MMH_AVX512 void OcclusionScanFromRightAvx512(const float* us, int n, uint8_t* occluded) {
-  const __m512 none = Set(std::numeric_limits<float>::infinity());
-  __m512 carry = none;  // minimum of everything right of the block, in every lane
-  for (int i = n - 16; i >= 0; i -= 16) {
-    const __m512 x = _mm512_loadu_ps(us + i);
-    // Lane j: minimum of lanes > j of this block.
-    __m512 m = _mm512_castsi512_ps(
-        _mm512_alignr_epi32(_mm512_castps_si512(none), _mm512_castps_si512(x), 1));
-    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
-                                                                 _mm512_castps_si512(m), 1)));
-    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
-                                                                 _mm512_castps_si512(m), 2)));
-    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
-                                                                 _mm512_castps_si512(m), 4)));
-    m = _mm512_min_ps(m, _mm512_castsi512_ps(_mm512_alignr_epi32(_mm512_castps_si512(none),
-                                                                 _mm512_castps_si512(m), 8)));
-    const __m512 lowest = _mm512_min_ps(m, carry);
-    const __mmask16 hidden = _mm512_cmp_ps_mask(x, lowest, _CMP_GE_OQ);
-    const __m128i old = _mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(occluded + i),
-                     _mm_or_si128(old, _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(hidden, 1))));
-    carry = _mm512_set1_ps(_mm512_reduce_min_ps(_mm512_min_ps(x, carry)));
+// Lane j takes lane j + k (k > 0) or j + k (k < 0) of x; lanes shifted in are `fill`.
+MMH_AVX512 inline __m512 ShiftLanes(__m512 x, __m512 fill, int k) {
+  const __m512i xi = _mm512_castps_si512(x), fi = _mm512_castps_si512(fill);
+  switch (k) {
+    case 1:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(fi, xi, 1));
+    case 2:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(fi, xi, 2));
+    case 4:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(fi, xi, 4));
+    case 8:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(fi, xi, 8));
+    case -1:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(xi, fi, 15));
+    case -2:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(xi, fi, 14));
+    case -4:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(xi, fi, 12));
+    default:
+      return _mm512_castsi512_ps(_mm512_alignr_epi32(xi, fi, 8));  // -8
   }
 }
 
-MMH_AVX512 void OcclusionScanFromLeftAvx512(const float* us, int n, uint8_t* occluded) {
-  const __m512 none = Set(-std::numeric_limits<float>::infinity());
-  __m512 carry = none;  // maximum of everything left of the block
-  for (int i = 0; i < n; i += 16) {
+template <bool kMin>
+MMH_AVX512 inline __m512 Extremum(__m512 a, __m512 b) {
+  return kMin ? _mm512_min_ps(a, b) : _mm512_max_ps(a, b);
+}
+
+// One direction of the occlusion scan: from the right (kFromRight: hidden iff not below the
+// minimum of everything right of it) or from the left (hidden iff not above the maximum of
+// everything left of it).
+template <bool kFromRight>
+MMH_AVX512 void OcclusionScanAvx512(const float* us, int n, uint8_t* occluded) {
+  const float infinity = std::numeric_limits<float>::infinity();
+  const __m512 none = Set(kFromRight ? infinity : -infinity);
+  const int direction = kFromRight ? 1 : -1;
+  __m512 carry = none;  // extremum of all blocks before this one in scan order
+  for (int block = 0; block < n / 16; ++block) {
+    const int i = kFromRight ? n - 16 - 16 * block : 16 * block;
     const __m512 x = _mm512_loadu_ps(us + i);
-    // Lane j: maximum of lanes < j of this block.
-    __m512 m = _mm512_castsi512_ps(
-        _mm512_alignr_epi32(_mm512_castps_si512(x), _mm512_castps_si512(none), 15));
-    for (int k : {1, 2, 4, 8}) {
-      const __m512 shifted = _mm512_castsi512_ps(
-          _mm512_alignr_epi32(_mm512_castps_si512(m), _mm512_castps_si512(none), 16 - k));
-      m = _mm512_max_ps(m, shifted);
-    }
-    const __m512 highest = _mm512_max_ps(m, carry);
-    const __mmask16 hidden = _mm512_cmp_ps_mask(x, highest, _CMP_LE_OQ);
+    // Lane j: extremum of the lanes before it in scan order.
+    __m512 m = ShiftLanes(x, none, direction);
+    for (int k : {1, 2, 4, 8}) m = Extremum<kFromRight>(m, ShiftLanes(m, none, direction * k));
+    const __m512 bound = Extremum<kFromRight>(m, carry);
+    const __mmask16 hidden = _mm512_cmp_ps_mask(x, bound, kFromRight ? _CMP_GE_OQ : _CMP_LE_OQ);
     const __m128i old = _mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(occluded + i),
                      _mm_or_si128(old, _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(hidden, 1))));
-    carry = _mm512_set1_ps(_mm512_reduce_max_ps(_mm512_max_ps(x, carry)));
+    const __m512 all = Extremum<kFromRight>(x, carry);
+    carry = Set(kFromRight ? _mm512_reduce_min_ps(all) : _mm512_reduce_max_ps(all));
   }
 }
 #undef MMH_AVX512
@@ -1079,9 +1085,9 @@ struct KinectSensor::Impl {
 #if MMH_SENSOR_AVX512
       if (vector) {
         if (source_x > 0) {
-          OcclusionScanFromRightAvx512(us, padded, scan);
+          OcclusionScanAvx512<true>(us, padded, scan);
         } else {
-          OcclusionScanFromLeftAvx512(us, padded, scan);
+          OcclusionScanAvx512<false>(us, padded, scan);
         }
         continue;
       }
