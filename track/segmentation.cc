@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "track/internal/frame_geometry.h"
 
 namespace mmh::track {
 
@@ -66,30 +67,10 @@ void Segmenter::SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& 
   // The play volume's image: the bounding box of its eight corners' projections.
   const double hx = setup_.play_area_width / 2 + options_.play_area_margin;
   const double hy = setup_.play_area_depth / 2 + options_.play_area_margin;
-  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
-  bool behind = false;
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d table_p((c & 1) ? hx : -hx, (c & 2) ? hy : -hy,
-                                  (c & 4) ? options_.max_height : options_.min_height);
-    const Eigen::Vector3d camera_p = camera_T_table * table_p;
-    if (camera_p.z() < 0.05) {
-      behind = true;
-      break;
-    }
-    const Eigen::Vector2d uv = intrinsics.Project(camera_p);
-    u0 = std::min(u0, uv.x());
-    v0 = std::min(v0, uv.y());
-    u1 = std::max(u1, uv.x());
-    v1 = std::max(v1, uv.y());
-  }
-  if (behind) {
-    roi_ = {0, 0, intrinsics.width, intrinsics.height};
-  } else {
-    roi_.x0 = std::clamp(static_cast<int>(std::floor(u0)), 0, intrinsics.width);
-    roi_.y0 = std::clamp(static_cast<int>(std::floor(v0)), 0, intrinsics.height);
-    roi_.x1 = std::clamp(static_cast<int>(std::ceil(u1)) + 1, 0, intrinsics.width);
-    roi_.y1 = std::clamp(static_cast<int>(std::ceil(v1)) + 1, 0, intrinsics.height);
-  }
+  const std::optional<ImageRect> box = internal::ProjectTableBox(
+      Eigen::Vector3d(-hx, -hy, options_.min_height), Eigen::Vector3d(hx, hy, options_.max_height),
+      camera_T_table, intrinsics);
+  roi_ = box ? *box : ImageRect{0, 0, intrinsics.width, intrinsics.height};
   const int rw = roi_.x1 - roi_.x0, rh = roi_.y1 - roi_.y0;
   table_rays_.resize(static_cast<size_t>(std::max(rw, 0)) * std::max(rh, 0));
   const Eigen::Matrix3f rotation = table_T_camera_.rotation.toRotationMatrix().cast<float>();
@@ -129,10 +110,7 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
 
   // Skin, where the colour image is registered to the depth image.
   cv::Mat skin;
-  const bool registered = frame.rgb.size() == static_cast<size_t>(3 * width * height) &&
-                          frame.color_intrinsics == frame.depth_intrinsics &&
-                          frame.color_T_depth.translation.norm() < 1e-9 &&
-                          std::abs(std::abs(frame.color_T_depth.rotation.w()) - 1) < 1e-12;
+  const bool registered = internal::ColorRegisteredToDepth(frame);
   if (options_.skin && registered) {
     const cv::Mat rgb(height, width, CV_8UC3, const_cast<uint8_t*>(frame.rgb.data()));
     cv::Mat ycrcb;

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "track/internal/frame_geometry.h"
 
 namespace mmh::track {
 
@@ -41,11 +42,7 @@ SliderReader::SliderReader(const TrackSetup& setup, const SliderReaderOptions& o
 SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_table) {
   SliderReading reading;
   const PinholeIntrinsics& k = frame.depth_intrinsics;
-  const bool registered = frame.depth.size() == static_cast<size_t>(k.pixel_count()) &&
-                          frame.rgb.size() == static_cast<size_t>(3 * k.pixel_count()) &&
-                          frame.color_intrinsics == k &&
-                          frame.color_T_depth.translation.norm() < 1e-9 &&
-                          std::abs(std::abs(frame.color_T_depth.rotation.w()) - 1) < 1e-12;
+  const bool registered = internal::ColorRegisteredToDepth(frame);
   if (!registered) {
     reading.reason = "no colour image registered to the depth image";
     return reading;
@@ -54,26 +51,15 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
   const double hx = setup_.like_box_length / 2 + options_.box_margin;
   const double hy = setup_.like_box_width / 2 + options_.box_margin;
   const double top = setup_.slider_block_size + options_.max_height_margin;
-  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d table_p(setup_.like_box_center_x + ((c & 1) ? hx : -hx),
-                                  setup_.like_box_center_y + ((c & 2) ? hy : -hy),
-                                  (c & 4) ? top : 0.0);
-    const Eigen::Vector3d camera_p = camera_T_table * table_p;
-    if (camera_p.z() < 0.05) {
-      reading.reason = "the Like box is behind the camera";
-      return reading;
-    }
-    const Eigen::Vector2d uv = k.Project(camera_p);
-    u0 = std::min(u0, uv.x());
-    v0 = std::min(v0, uv.y());
-    u1 = std::max(u1, uv.x());
-    v1 = std::max(v1, uv.y());
+  const std::optional<ImageRect> box = internal::ProjectTableBox(
+      Eigen::Vector3d(setup_.like_box_center_x - hx, setup_.like_box_center_y - hy, 0.0),
+      Eigen::Vector3d(setup_.like_box_center_x + hx, setup_.like_box_center_y + hy, top),
+      camera_T_table, k);
+  if (!box) {
+    reading.reason = "the Like box is behind the camera";
+    return reading;
   }
-  const int x0 = std::clamp(static_cast<int>(std::floor(u0)), 0, k.width);
-  const int y0 = std::clamp(static_cast<int>(std::floor(v0)), 0, k.height);
-  const int x1 = std::clamp(static_cast<int>(std::ceil(u1)) + 1, 0, k.width);
-  const int y1 = std::clamp(static_cast<int>(std::ceil(v1)) + 1, 0, k.height);
+  const int x0 = box->x0, y0 = box->y0, x1 = box->x1, y1 = box->y1;
   if (x1 <= x0 || y1 <= y0) {
     reading.reason = "the Like box is outside the image";
     return reading;
