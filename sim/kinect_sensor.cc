@@ -240,7 +240,6 @@ inline uint32_t CounterHash(uint32_t key, uint32_t counter) {
 // < 3e-10), Horner steps as std::fma. The AVX-512 kernels repeat these operations in the same
 // order (std::fma and vfmadd round alike).
 constexpr float kLn2 = 0.693147180559945309f;
-constexpr float kSqrtHalf = 0.707106781186547524f;
 constexpr float kSqrt2 = 1.41421356237309505f;
 constexpr float kHalfPi = 1.57079632679489662f;
 

@@ -4,16 +4,19 @@
 // sensor noise.
 //
 // Per frame, in this order (docs/sensor.md has the derivations):
-//  1. geometry: camera rays against the scene. Incremental mode casts the static scene once and
-//     afterwards only the pixels that the moving objects' bounds cover (nearer hits replace the
-//     cached static ones); full mode re-casts every pixel. Both give the same frame.
+//  1. geometry: camera rays against the scene, keeping per pixel only depth, disparity, incidence
+//     cosine and shaded colour. Incremental mode casts the static scene once and afterwards only
+//     the pixels that each moving object's projected cluster boxes cover, against that object
+//     alone (nearer hits replace the cached static ones); full mode re-casts the static scene at
+//     every pixel, then the same moving-object casts. Both give the same frame.
 //  2. occlusion of the projector (IR shadow) and, for registered depth, of the IR camera: both
 //     sit on the camera's x axis, so a point is hidden from them exactly when a nearer point of the
 //     same image row covers it in their view: a row scan with a running extremum.
 //  3. per pixel, with noise from a counter-based generator keyed by (seed, frame, pixel), so that
-//     a frame is the same for any thread count: lateral noise (edge pixels take their neighbour's
-//     depth), axial noise sigma_z(z, theta), the disparity lattice, missing pixels (shadow, edges,
-//     grazing angles, range, speckle), and colour noise.
+//     a frame is the same for any thread count and SIMD level: lateral noise (edge pixels take
+//     their neighbour's depth), axial noise sigma_z(z, theta) (Box-Muller normals), the disparity
+//     lattice, missing pixels (shadow, edges, grazing angles, range, speckle), and colour noise.
+// Sequences render fastest with RenderFrames (below): one scene and sensor per core.
 #pragma once
 
 #include <cstdint>
