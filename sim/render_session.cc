@@ -244,7 +244,7 @@ nlohmann::json RenderSummary::ToJson() const {
   j["rays"] = timings.rays;
   j["pixels_recast"] = timings.pixels_recast;
   j["seconds_per_step"] = {{"cast", timings.cast},
-                           {"shade", timings.shade},
+                           {"restore", timings.restore},
                            {"occlusion", timings.occlusion},
                            {"noise", timings.noise}};
   return j;
