@@ -44,6 +44,7 @@ void DetectionOptions::Validate(const std::string& prefix) const {
                   ">= 0 (0: never)");
   }
   RequireNonNegative(switch_margin, prefix + ".switch_margin");
+  RequireNonNegative(far_switch_margin, prefix + ".far_switch_margin");
   RequireProbability(recheck_free_space, prefix + ".recheck_free_space");
   if (coarse_end_distance > coarse_start_distance) {
     ThrowBadValue(prefix + ".coarse_end_distance", FormatNumber(coarse_end_distance),
@@ -389,6 +390,7 @@ void ProxyTracker::PrepareData() {
 }
 
 TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
+  const double pi = std::numbers::pi;
   TrackFrameResult result;
   result.index = frame.index;
   result.timestamp = frame.timestamp;
@@ -483,7 +485,12 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
       }
       std::optional<Candidate> detected = Detect(frame, predicted);
       if (detected && detected->good &&
-          (!chosen->good || detected->Score() > chosen->Score() + d.switch_margin)) {
+          (!chosen->good ||
+           detected->Score() >
+               chosen->Score() + (RotationAngle(detected->icp.proxy_T_camera.rotation,
+                                                chosen->icp.proxy_T_camera.rotation) > pi / 4
+                                      ? d.far_switch_margin
+                                      : d.switch_margin))) {
         chosen = detected;
         result.detected = true;
       } else if (!chosen->good) {

@@ -57,6 +57,9 @@ struct DetectionOptions {
   int recheck_interval = 15;
   double recheck_free_space = 0.04;
   double switch_margin = 0.05;
+  // ... and far_switch_margin higher when it is more than 45 deg from the tracked pose (a verified
+  // pose does not turn that far in a frame: such a switch is to a twin, or from one).
+  double far_switch_margin = 0.15;
 
   template <class V>
   void VisitFields(V& v) {
@@ -74,6 +77,7 @@ struct DetectionOptions {
     v("recheck_interval", recheck_interval);
     v("recheck_free_space", recheck_free_space);
     v("switch_margin", switch_margin);
+    v("far_switch_margin", far_switch_margin);
   }
   void Validate(const std::string& prefix) const;
 };

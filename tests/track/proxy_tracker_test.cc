@@ -70,10 +70,10 @@ TEST(ProxyTrackerTest, DemoWalkWithHand) {
   EXPECT_GE(result.summary.success_rate, 0.99);
 }
 
-// Five more walks (other noise seeds, 6-10 s rounds, yaw swings 0.2-0.6 rad), pooled. A
-// regression guard below the thresholds: one of them (seed 3) loses 19 frames to the
-// Soldier's upside-down twin after a check, which the 99 % and 15 frames do not allow
-// (docs/tracker.md, "Known weaknesses").
+// Five more walks (other noise seeds, 6-10 s rounds, yaw swings 0.2-0.6 rad), pooled: every loss
+// recovered within 15 frames, but one of them (seed 3) spends 7 frames in the Soldier's
+// upside-down twin, so not every take reaches 99 % (docs/tracker.md, "Known weaknesses"); the
+// pooled share is guarded at 98 %.
 TEST(ProxyTrackerTest, OtherWalksPooled) {
   int frames = 0, successes = 0, longest = 0;
   std::vector<double> rotations, translations;
@@ -93,8 +93,8 @@ TEST(ProxyTrackerTest, OtherWalksPooled) {
   }
   EXPECT_LE(metrics::Quantile(rotations, 0.5), 1.0);
   EXPECT_LE(metrics::Quantile(translations, 0.5), 0.002);
-  EXPECT_GE(static_cast<double>(successes) / frames, 0.97);
-  EXPECT_LE(longest, 20);
+  EXPECT_GE(static_cast<double>(successes) / frames, 0.98);
+  EXPECT_LE(longest, 15);
 }
 
 // A fast take: the walk at twice the demo's speed with a tumbling tilt of up to 20 deg and wide
