@@ -50,7 +50,7 @@ struct TestRow {
   std::string analysis, test, statistic_name;
   double statistic = NAN, df1 = NAN, df2 = NAN, p_value = NAN, estimate = NAN;
   double conf_low = NAN, conf_high = NAN, conf_level = NAN;
-  std::string effect_size_name;
+  std::string effect_size_name = "";
   double effect_size = NAN, n = NAN;
 };
 
@@ -74,7 +74,11 @@ TestRow& SetEstimate(TestRow& row, double p_value, double estimate, const Confid
 }
 
 TestRow TRow(const std::string& analysis, const TTestResult& t) {
-  TestRow row{analysis, "one-sample t-test", "t", t.t, t.df};
+  TestRow row{.analysis = analysis,
+              .test = "one-sample t-test",
+              .statistic_name = "t",
+              .statistic = t.t,
+              .df1 = t.df};
   SetEstimate(row, t.p_value, t.mean, t.conf_int);
   row.effect_size_name = "cohens_d";
   row.effect_size = t.cohens_d;
@@ -83,7 +87,11 @@ TestRow TRow(const std::string& analysis, const TTestResult& t) {
 }
 
 TestRow FriedmanRow(const FriedmanResult& f) {
-  TestRow row{"rankings", "Friedman rank sum test", "chi-squared", f.statistic, f.df};
+  TestRow row{.analysis = "rankings",
+              .test = "Friedman rank sum test",
+              .statistic_name = "chi-squared",
+              .statistic = f.statistic,
+              .df1 = f.df};
   row.p_value = f.p_value;
   row.effect_size_name = "kendalls_w";
   row.effect_size = f.kendalls_w;
@@ -92,7 +100,10 @@ TestRow FriedmanRow(const FriedmanResult& f) {
 }
 
 TestRow BinomialRow(const std::string& analysis, const BinomialTestResult& b) {
-  TestRow row{analysis, "exact binomial test", "successes", static_cast<double>(b.successes)};
+  TestRow row{.analysis = analysis,
+              .test = "exact binomial test",
+              .statistic_name = "successes",
+              .statistic = static_cast<double>(b.successes)};
   SetEstimate(row, b.p_value, b.estimate, b.conf_int);
   row.effect_size_name = "cohens_h";
   row.effect_size = b.cohens_h;
@@ -101,7 +112,11 @@ TestRow BinomialRow(const std::string& analysis, const BinomialTestResult& b) {
 }
 
 TestRow ChiRow(const std::string& analysis, const ChiSquaredResult& c) {
-  TestRow row{analysis, c.method, "X-squared", c.statistic, c.df};
+  TestRow row{.analysis = analysis,
+              .test = c.method,
+              .statistic_name = "X-squared",
+              .statistic = c.statistic,
+              .df1 = c.df};
   row.p_value = c.p_value;
   row.effect_size_name = c.effect_size_name;
   row.effect_size = c.effect_size;
@@ -110,14 +125,22 @@ TestRow ChiRow(const std::string& analysis, const ChiSquaredResult& c) {
 }
 
 TestRow ShapiroRow(const std::string& analysis, const ShapiroWilkResult& s) {
-  TestRow row{analysis, "Shapiro-Wilk normality test", "W", s.w};
+  TestRow row{.analysis = analysis,
+              .test = "Shapiro-Wilk normality test",
+              .statistic_name = "W",
+              .statistic = s.w};
   row.p_value = s.p_value;
   row.n = static_cast<double>(s.n);
   return row;
 }
 
 TestRow FRow(const std::string& analysis, const std::string& test, const FTest& f, double n) {
-  TestRow row{analysis, test, "F", f.f, f.num_df, f.den_df};
+  TestRow row{.analysis = analysis,
+              .test = test,
+              .statistic_name = "F",
+              .statistic = f.f,
+              .df1 = f.num_df,
+              .df2 = f.den_df};
   row.p_value = f.p_value;
   row.effect_size_name = "partial_eta_squared";
   row.effect_size = f.partial_eta_squared;
@@ -409,7 +432,11 @@ std::string StudyAnalysis::TestsCsv() const {
     // The take differences (fixed effects after the intercept): take j minus take 1.
     for (std::size_t j = 1; j < m->fixed_effects.size(); ++j) {
       const FixedEffect& e = m->fixed_effects[j];
-      TestRow row{"h3", "mixed model t (Satterthwaite) " + e.name + " - take1", "t", e.t, e.df};
+      TestRow row{.analysis = "h3",
+                  .test = "mixed model t (Satterthwaite) " + e.name + " - take1",
+                  .statistic_name = "t",
+                  .statistic = e.t,
+                  .df1 = e.df};
       SetEstimate(row, e.p_value, e.estimate, e.conf_int).n = n;
       out += TestRowCsv(row);
     }
