@@ -72,6 +72,8 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
 
   const Rigid3 table_T_camera = camera_T_table.Inverse();
   xs_.clear();
+  // Per image row, the block's leftmost and rightmost pixels (table x grows with image u).
+  std::vector<int> row_first(y1 - y0, -1), row_last(y1 - y0, -1);
   for (int v = y0; v < y1; ++v) {
     for (int u = x0; u < x1; ++u) {
       if (!green.at<uint8_t>(v - y0, u - x0)) continue;
@@ -84,6 +86,8 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
         continue;
       }
       xs_.push_back(static_cast<float>(table_p.x()));
+      if (row_first[v - y0] < 0) row_first[v - y0] = u;
+      row_last[v - y0] = u;
     }
   }
   reading.points = static_cast<int>(xs_.size());
@@ -100,6 +104,34 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
   const double lo = quantile(options_.edge_quantile);
   const double hi = quantile(1 - options_.edge_quantile);
   reading.center_x = 0.5 * (lo + hi);
+  // The hand moving the block may hide one of its ends: a row's end is hidden when the pixel just
+  // beyond it is nearer the camera than the block (a finger in front), not farther (the table).
+  // When the visible extent is short of the block and the hiding is on one side only, the other
+  // end is the block's true edge and the centre lies half a block from it.
+  const double size = setup_.slider_block_size;
+  if (hi - lo < 0.9 * size) {
+    const auto depth_at = [&](int u, int v) {
+      return u >= 0 && u < k.width ? frame.depth[static_cast<size_t>(v) * k.width + u] : 0;
+    };
+    const auto hidden = [&](int v, int edge, int step) {
+      const uint16_t block = depth_at(edge, v);
+      for (int u = edge + step; std::abs(u - edge) <= 3; u += step) {
+        const uint16_t d = depth_at(u, v);
+        if (d == 0) continue;
+        return static_cast<double>(block - d) * frame.depth_scale > 0.005;
+      }
+      return false;
+    };
+    int hidden_low = 0, hidden_high = 0, rows = 0;
+    for (int v = y0; v < y1; ++v) {
+      if (row_first[v - y0] < 0) continue;
+      ++rows;
+      hidden_low += hidden(v, row_first[v - y0], -1);
+      hidden_high += hidden(v, row_last[v - y0], +1);
+    }
+    if (hidden_low > rows / 2 && hidden_low >= 2 * hidden_high) reading.center_x = hi - 0.5 * size;
+    if (hidden_high > rows / 2 && hidden_high >= 2 * hidden_low) reading.center_x = lo + 0.5 * size;
+  }
   const double travel = (setup_.like_box_length - setup_.slider_block_size) / 2;
   reading.raw_value = 5.0 * (reading.center_x - setup_.like_box_center_x) / travel;
   reading.value = std::clamp(reading.raw_value, -5.0, 5.0);

@@ -37,7 +37,7 @@ class SimTake {
     const double t = i / config_.sensor.frame_rate;
     const Rigid3 table_T_proxy = table_T_proxy_ ? table_T_proxy_(t) : config_.motion.TableTProxy(t);
     const double slider = slider_ ? slider_(t) : config_.motion.SliderValue(t);
-    scene_->SetFrame(table_T_proxy, slider);
+    scene_->SetFrame(table_T_proxy, slider, hand_);
     if (camera_T_proxy) *camera_T_proxy = depth_T_table_ * table_T_proxy;
     if (slider_value) *slider_value = slider;
     return sensor_->Render(i);
@@ -60,9 +60,12 @@ class SimTake {
   const TriangleMesh& model() const { return model_; }
   const Rigid3& depth_T_table() const { return depth_T_table_; }
   const sim::RenderConfig& config() const { return config_; }
+  // Which object the hand holds: the proxy (recording) or the slider block (annotation session).
+  void set_hand(sim::TableTopScene::Hand hand) { hand_ = hand; }
 
  private:
   sim::RenderConfig config_;
+  sim::TableTopScene::Hand hand_ = sim::TableTopScene::Hand::kOnProxy;
   std::function<Rigid3(double)> table_T_proxy_;
   std::function<double(double)> slider_;
   TriangleMesh model_;

@@ -17,8 +17,13 @@ namespace {
 using test_util::ErrorOf;
 using ::testing::HasSubstr;
 
-TEST(SliderReaderTest, ValueRmseAgainstTheRenderedBlock) {
+// RMSE of the slider over the demo sweep, with the hand on the proxy (recording) or on the block
+// (annotation session: fingers on its left end, thumb on its right, hiding part of it).
+class SliderReaderTest : public ::testing::TestWithParam<sim::TableTopScene::Hand> {};
+
+TEST_P(SliderReaderTest, ValueRmseAgainstTheRenderedBlock) {
   test_take::SimTake take;
+  take.set_hand(GetParam());
   const TrackSetup setup = take.Setup();
   SliderReader reader(setup, SliderReaderOptions());
   std::optional<Rigid3> camera_T_table;
@@ -47,7 +52,11 @@ TEST(SliderReaderTest, ValueRmseAgainstTheRenderedBlock) {
   EXPECT_LE(worst, 1.0);
 }
 
-TEST(SliderReaderTest, MissingBlockAndBadFramesAreReported) {
+INSTANTIATE_TEST_SUITE_P(HandOnProxyOrBlock, SliderReaderTest,
+                         ::testing::Values(sim::TableTopScene::Hand::kOnProxy,
+                                           sim::TableTopScene::Hand::kOnSlider));
+
+TEST(SliderReaderErrorsTest, MissingBlockAndBadFramesAreReported) {
   test_take::SimTake take;
   const TrackSetup setup = take.Setup();
   SliderReader reader(setup, SliderReaderOptions());
