@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace mmh {
 
@@ -36,6 +37,9 @@ struct Rigid3 {
 // Linear interpolation of the translations and spherical linear interpolation of the rotations
 // (Shoemake 1985) along the shorter arc; weight 0 gives `from`, 1 gives `to`.
 Rigid3 Interpolate(const Rigid3& from, const Rigid3& to, double weight);
+
+// An angle [rad] wrapped into [-pi, pi].
+inline double WrapAngle(double angle) { return std::remainder(angle, 2 * 3.14159265358979323846); }
 
 // Angle of the rotation from a to b in radians, in [0, pi].
 double RotationAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b);

@@ -41,7 +41,6 @@ double Ease(double p) {
   p = std::clamp(p, 0.0, 1.0);
   return p - 0.25 * std::sin(2 * kPi * p) / (2 * kPi);
 }
-double WrapAngle(double a) { return std::remainder(a, 2 * kPi); }
 
 Eigen::Quaterniond AxisAngle(double angle, const Eigen::Vector3d& axis) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis));
@@ -265,7 +264,12 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
   double step_phase = 0;
   double turn_from = heading;
   double segment_pitch = 0;
-  Eigen::Vector2d origin = position;  // where the current segment started
+  // The current segment's path from where the figure actually stood when it began (after a hit
+  // it stands where the target was), set once per segment.
+  std::vector<Eigen::Vector2d> polyline;
+  double length = 0;
+  Eigen::Vector2d start_tangent = Eigen::Vector2d::Zero();
+  bool closed = false;
   int current = -1;
   const double heading_gain = 1 - std::exp(-dt / options.heading_time_constant);
   const double smooth_gain = 1 - std::exp(-dt / 0.04);
@@ -282,26 +286,25 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
       out.segments.push_back({seg.script_beat, seg.kind, i, i});
       turn_from = heading;
       segment_pitch = pitch;
-      origin = position;
       current = k;
+      polyline.clear();
+      if (seg.polyline.size() >= 2 || seg.hit_target) {
+        closed = (seg.polyline.front() - seg.polyline.back()).norm() < 1e-6;
+        polyline = seg.polyline;
+        polyline.front() = position;
+        if (seg.hit_target) polyline = {position, seg.hit_target->head<2>()};
+        length = PolylineLength(polyline);
+        PolylinePoint(polyline, 0.0, &start_tangent);
+      }
     }
     const double tau = t - seg_start[k];
     const double p = seg.Progress(tau);
     const bool hesitating = seg.Hesitating(tau);
-    const double intensity =
-        seg.amplitude * (beat.intensity + (beat.intensity_end - beat.intensity) * p);
+    const double intensity = seg.amplitude * beat.IntensityAt(p);
     const BeatStyleTarget target = ScriptTarget(seg.kind);
 
     // Where the figure stands.
-    if (seg.polyline.size() >= 2 || seg.hit_target) {
-      // From where the figure actually is (after a hit it stands where the target was).
-      const bool closed = (seg.polyline.front() - seg.polyline.back()).norm() < 1e-6;
-      std::vector<Eigen::Vector2d> polyline = seg.polyline;
-      polyline.front() = origin;
-      if (seg.hit_target) polyline = {origin, seg.hit_target->head<2>()};
-      const double length = PolylineLength(polyline);
-      Eigen::Vector2d start_tangent;
-      PolylinePoint(polyline, 0.0, &start_tangent);
+    if (!polyline.empty()) {
       if (seg.kind == BeatKind::kHit || seg.hit_target) {
         position = PolylinePoint(polyline, length * Ease(std::min(p / kHitApproachEnd, 1.0)));
       } else if (seg.wrong_direction && !closed) {

@@ -29,6 +29,16 @@ struct AnimatorProfile {
   double yaw_style = 1.0;     // head turns
   double tempo_style = 1.0;   // step rate
 
+  template <class V>
+  void VisitFields(V& v) {
+    v("skill", skill);
+    v("energy", energy);
+    v("learning", learning);
+    v("bounce_style", bounce_style);
+    v("sway_style", sway_style);
+    v("yaw_style", yaw_style);
+    v("tempo_style", tempo_style);
+  }
   // Skill at take k (0-based): 1 - (1 - skill)(1 - learning)^k; the paper's animators ranked
   // later takes higher.
   double SkillAtTake(int take) const;

@@ -376,13 +376,7 @@ void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
   WriteTum(out / "take.tum", take.table_T_proxy);
   nlohmann::json participant;
   participant["index"] = motion.participant->index;
-  participant["animator"] = {{"skill", motion.participant->animator.skill},
-                             {"energy", motion.participant->animator.energy},
-                             {"learning", motion.participant->animator.learning},
-                             {"bounce_style", motion.participant->animator.bounce_style},
-                             {"sway_style", motion.participant->animator.sway_style},
-                             {"yaw_style", motion.participant->animator.yaw_style},
-                             {"tempo_style", motion.participant->animator.tempo_style}};
+  participant["animator"] = mmh::ToJson(motion.participant->animator);
   participant["annotator"] = mmh::ToJson(motion.participant->annotator);
   participant["take"] = take.take;
   participant["skill_at_take"] = take.skill;

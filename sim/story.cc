@@ -272,6 +272,10 @@ BeatStyleTarget ScriptTarget(BeatKind kind) {
   return t;
 }
 
+double Beat::IntensityAt(double u) const {
+  return intensity + (intensity_end - intensity) * std::clamp(u, 0.0, 1.0);
+}
+
 double StoryObject::BeatDuration(int i) const {
   const double next = i + 1 < static_cast<int>(beats.size()) ? beats[i + 1].start : end;
   return next - beats[i].start;

@@ -80,6 +80,9 @@ struct Beat {
   double intensity_end = 1;  // ... and at its end (linear in between)
   std::string target;        // hit: the object whose head is hit
   std::string meaning;       // the script's words for this beat
+
+  // Intensity at progress u of the beat (0 at its start, 1 at its end; clamped).
+  double IntensityAt(double u) const;
 };
 
 struct StoryObject {

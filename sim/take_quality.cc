@@ -9,17 +9,10 @@
 namespace mmh::sim {
 namespace {
 
-double WrapAngle(double a) { return std::remainder(a, 2 * std::numbers::pi); }
-
 double LogRatioScore(double measured, double target, double log_sd) {
   if (target <= 0.0) return 1.0;
   const double r = std::log(std::max(measured, 1e-4) / target);
   return std::exp(-r * r / (2 * log_sd * log_sd));
-}
-
-// Intensity of beat `beat` at progress u (linear between its start and end values).
-double IntensityAt(const Beat& beat, double u) {
-  return beat.intensity + (beat.intensity_end - beat.intensity) * std::clamp(u, 0.0, 1.0);
 }
 
 }  // namespace
@@ -131,7 +124,7 @@ QualityTrace ComputeTakeQuality(const QualityInputs& in, const QualityOptions& o
     for (int i = first; i <= last; ++i) {
       const int a = std::max(first, i - w), b = std::min(last, i + w);
       const double u = in.script_progress[i];
-      const double intensity = IntensityAt(beat, u);
+      const double intensity = beat.IntensityAt(u);
 
       trace.fidelity[i] = segment.performed_kind == beat.kind ? 1.0 : options.kind_mismatch;
 
