@@ -591,7 +591,9 @@ PerformedTake PerformTake(const Story& story, int object, const AnimatorProfile&
       ThrowBadValue(
           story.file + ": objects[" + std::to_string(object) + "] (\"" + o.name + "\")",
           "a layered object (beat " + std::to_string(i) + " hits \"" + o.beats[i].target + "\")",
-          "an object without hit beats: perform it with PerformLayeredTake");
+          "an object without hit beats: a layered object's takes are made by "
+          "PerformLayeredTake from the earlier objects' montage, which a single "
+          "recording does not have");
     }
   }
   Random random(DeriveSeed(
