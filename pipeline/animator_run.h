@@ -1,0 +1,134 @@
+// One animator end to end (`mmh run`): each take of a story performed by a simulated participant,
+// recorded through the Kinect model and tracked by the real tracker, annotated with the slider
+// block and read by the real slider reader; then the montage from the tracked takes and read
+// annotations (as the real system has them) and, for comparison, from the ground truth.
+//
+// Fidelity: kFull renders every recording and annotation session and runs the tracker and slider
+// reader on the frames; kFast skips the frames and applies the measured tracker and slider-reader
+// error model (pipeline/error_model.h) to the ground truth, for large sweeps.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/annotation.h"
+#include "core/config.h"
+#include "core/rigid3.h"
+#include "core/trajectory.h"
+#include "metrics/tracking_metrics.h"
+#include "montage/compose.h"
+#include "pipeline/error_model.h"
+#include "sim/annotator.h"
+#include "sim/performance.h"
+#include "sim/population.h"
+#include "sim/render_session.h"
+#include "sim/story.h"
+#include "track/proxy_tracker.h"
+#include "track/slider_reader.h"
+
+namespace mmh::pipeline {
+
+enum class Fidelity {
+  kFull,  // render every frame, run the tracker and the slider reader on it
+  kFast,  // the measured error model applied to the ground truth (no frames)
+};
+std::span<const std::pair<Fidelity, const char*>> EnumNames(Fidelity);
+
+// Section "run".
+struct RunOptions {
+  // Takes of the story's object (render.object) recorded, annotated and composited (paper: 3).
+  int takes = 3;
+  // A practice story (e.g. configs/stories/mario.json) performed once before the takes (paper:
+  // "the participants first practised with Mario"): recorded and tracked like a take, not
+  // composited; the takes' skill index starts after it. Empty: no practice.
+  std::string practice;
+  Fidelity fidelity = Fidelity::kFull;
+  // Lost frames get a pose for the compositor by interpolating the neighbouring estimates
+  // (slerp and lerp; the first or last estimate held at the ends). A take with fewer than
+  // min_tracked_share of its frames estimated is a failed take (InputError-like RunError).
+  double min_tracked_share = 0.5;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("takes", takes);
+    v("practice", practice);
+    v("fidelity", fidelity);
+    v("min_tracked_share", min_tracked_share);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+// Every section of a run config: the render sections (sim/render_session.h; render.story,
+// render.animator and render.object choose the scenario), "tracker" and "slider" (track/),
+// "montage" (montage::ComposeOptions), "metrics" (metrics::PoseErrorOptions), "error_model"
+// (pipeline/error_model.h) and "run". Unknown sections and keys are errors.
+struct RunConfig {
+  sim::RenderConfig render;
+  track::ProxyTrackerOptions tracker;
+  track::SliderReaderOptions slider;
+  montage::ComposeOptions montage;
+  metrics::PoseErrorOptions metrics;
+  ErrorModelOptions error_model;
+  RunOptions run;
+
+  // `extra_sections` are accepted and left alone (a study config's "study", "scorers", "viewer").
+  static RunConfig FromConfig(const Config& config,
+                              const std::vector<std::string>& extra_sections = {});
+  nlohmann::json ToJson() const;
+};
+
+// One take through the pipeline. Trajectories are table_T_proxy with timestamps i / frame_rate.
+struct TakeRun {
+  int take = 0;                      // index within the story's object (0-based)
+  sim::PerformedTake performed;      // ground truth: motion, latent quality, flaws
+  sim::AnnotationSession annotation; // ground truth: judgement, delay, slider block
+  Trajectory tracked;                // #frames, lost frames filled (see RunOptions)
+  std::vector<track::TrackStatus> status;  // #frames
+  Annotation truth_annotation;       // the slider block's true values
+  Annotation read_annotation;        // the slider reader's values (held where not found)
+  std::vector<bool> slider_found;    // #frames
+  double record_seconds = 0.0;       // render + track of the recording session [s]
+  double annotate_seconds = 0.0;     // render + read of the annotation session [s]
+};
+
+struct StageSeconds {
+  double perform = 0.0;   // performances and annotator simulations
+  double record = 0.0;    // recording sessions: render + track (wall clock, sessions in parallel)
+  double annotate = 0.0;  // annotation sessions: render + slider reading
+  double compose = 0.0;   // both montages
+  double metrics = 0.0;
+  double total = 0.0;
+};
+
+struct AnimatorRun {
+  sim::Participant participant;
+  std::optional<TakeRun> practice;
+  std::vector<TakeRun> takes;
+  montage::Montage montage;        // from the tracked takes and read annotations
+  montage::Montage truth_montage;  // from the ground truth
+  // Latent quality of each montage frame, carried from the takes' frames it shows
+  // (sim::CompositeQuality).
+  std::vector<double> montage_quality;
+  std::vector<double> truth_montage_quality;
+  nlohmann::json metrics;  // metrics.json (see pipeline/run_metrics.h)
+  StageSeconds seconds;
+  int rendered_frames = 0;  // frames rendered and tracked or read (0 in fast fidelity)
+};
+
+// progress(done, total) in frames (or in takes in fast fidelity); may be called from any thread,
+// never concurrently.
+using Progress = std::function<void(std::int64_t done, std::int64_t total)>;
+
+// Runs participant `animator` of config.render.population through `config.run.takes` takes of
+// config.render.story (object config.render.object). Deterministic in the config, independent of
+// the thread count. Throws InputError for bad input (a missing story, too short takes, a take whose
+// tracking failed entirely), naming what is wrong.
+AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress = {});
+
+}  // namespace mmh::pipeline
