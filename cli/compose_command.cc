@@ -28,27 +28,25 @@ struct ComposeArgs {
   std::vector<int> markers;
 };
 
-std::string TimelineCsv(const montage::Montage& montage) {
-  std::ostringstream out;
-  out << "reference_frame,take";
-  const std::size_t m = montage.warped_annotations.size();
-  for (std::size_t l = 0; l < m; ++l) out << ",warp_" << l;
-  for (std::size_t l = 0; l < m; ++l) out << ",warped_annotation_" << l;
-  out << '\n';
-  for (std::size_t t = 0; t < montage.labels.size(); ++t) {
-    out << t << ',' << montage.labels[t];
-    for (std::size_t l = 0; l < m; ++l) out << ',' << montage.warps[l][t];
-    for (std::size_t l = 0; l < m; ++l)
-      out << ',' << FormatNumber(montage.warped_annotations[l][t]);
-    out << '\n';
-  }
-  return out.str();
+}  // namespace
+
+Config LoadConfig(const CommonFlags& common) {
+  Config config;
+  if (!common.config_file.empty()) config = Config::Load(common.config_file);
+  for (const auto& set : common.sets) config.Set(set);
+  return config;
 }
 
+std::shared_ptr<void> LimitThreads(int threads) {
+  if (threads <= 0) return nullptr;
+  return std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               threads);
+}
+
+namespace {
+
 void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
-  Config config;
-  if (!args.common.config_file.empty()) config = Config::Load(args.common.config_file);
-  for (const auto& set : args.common.sets) config.Set(set);
+  const Config config = LoadConfig(args.common);
   config.RequireOnlySections({"montage"});
   const auto options = config.Get<montage::ComposeOptions>("montage");
 
@@ -58,11 +56,7 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
                       std::to_string(args.takes.size()) + " takes",
                   "one annotation file per take, in the same order");
   }
-  std::unique_ptr<tbb::global_control> threads;
-  if (args.common.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                    args.common.threads);
-  }
+  const auto threads = LimitThreads(args.common.threads);
 
   // Everything is read and computed before anything is written: bad input leaves no output.
   std::vector<Trajectory> takes;
@@ -107,7 +101,7 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
     WriteTum(out / "markers.tum", marker_poses,
              "spatial markers: montage poses at the marked frames");
   }
-  WriteFileAtomically(out / "timeline.csv", TimelineCsv(montage));
+  WriteFileAtomically(out / "timeline.csv", montage::TimelineToCsv(montage));
   WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
   WriteFileAtomically(

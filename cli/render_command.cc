@@ -1,6 +1,5 @@
 #include "cli/render_command.h"
 
-#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -20,19 +19,6 @@
 
 namespace mmh::cli {
 namespace {
-
-std::unique_ptr<tbb::global_control> LimitThreads(int threads) {
-  if (threads <= 0) return nullptr;
-  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                               threads);
-}
-
-Config LoadConfig(const CommonFlags& common) {
-  Config config;
-  if (!common.config_file.empty()) config = Config::Load(common.config_file);
-  for (const auto& set : common.sets) config.Set(set);
-  return config;
-}
 
 void RunRender(const CommonFlags& common, const std::vector<std::string>& argv) {
   const Config config = LoadConfig(common);

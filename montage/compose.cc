@@ -250,4 +250,21 @@ std::string SegmentsToCsv(const std::vector<MontageSegment>& segments) {
   return out.str();
 }
 
+std::string TimelineToCsv(const Montage& montage) {
+  std::ostringstream out;
+  out << "reference_frame,take";
+  const std::size_t m = montage.warped_annotations.size();
+  for (std::size_t l = 0; l < m; ++l) out << ",warp_" << l;
+  for (std::size_t l = 0; l < m; ++l) out << ",warped_annotation_" << l;
+  out << '\n';
+  for (std::size_t t = 0; t < montage.labels.size(); ++t) {
+    out << t << ',' << montage.labels[t];
+    for (std::size_t l = 0; l < m; ++l) out << ',' << montage.warps[l][t];
+    for (std::size_t l = 0; l < m; ++l)
+      out << ',' << FormatNumber(montage.warped_annotations[l][t]);
+    out << '\n';
+  }
+  return out.str();
+}
+
 }  // namespace mmh::montage

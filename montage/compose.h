@@ -108,5 +108,7 @@ Montage Compose(const std::vector<Trajectory>& takes, const std::vector<Annotati
 nlohmann::json SummaryToJson(const ComposeSummary& summary,
                              const std::vector<MontageSegment>& segments);
 std::string SegmentsToCsv(const std::vector<MontageSegment>& segments);
+// Per reference frame: the chosen take, each take's warp and warped annotation (tidy CSV).
+std::string TimelineToCsv(const Montage& montage);
 
 }  // namespace mmh::montage

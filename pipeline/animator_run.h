@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -85,16 +86,23 @@ struct RunConfig {
 
 // One take through the pipeline. Trajectories are table_T_proxy with timestamps i / frame_rate.
 struct TakeRun {
-  int take = 0;                      // index within the story's object (0-based)
-  sim::PerformedTake performed;      // ground truth: motion, latent quality, flaws
-  sim::AnnotationSession annotation; // ground truth: judgement, delay, slider block
-  Trajectory tracked;                // #frames, lost frames filled (see RunOptions)
+  int take = 0;                       // index within the story's object (0-based)
+  sim::PerformedTake performed;       // ground truth: motion, latent quality, flaws
+  sim::AnnotationSession annotation;  // ground truth: judgement, delay, slider block (not for the
+                                      // practice take, which is not annotated)
+  Trajectory truth;    // #frames: the performed motion (render.frames may shorten the take)
+  Trajectory tracked;  // #frames, lost frames filled (see RunOptions)
   std::vector<track::TrackStatus> status;  // #frames
-  Annotation truth_annotation;       // the slider block's true values
-  Annotation read_annotation;        // the slider reader's values (held where not found)
-  std::vector<bool> slider_found;    // #frames
-  double record_seconds = 0.0;       // render + track of the recording session [s]
-  double annotate_seconds = 0.0;     // render + read of the annotation session [s]
+  double estimated_share = 0.0;            // share of frames not lost
+  // The depth camera's pose over the table: true, and as the tracker estimated it (the plane it
+  // found and the setup's tape marks). Identity for both in fast fidelity.
+  Rigid3 camera_T_table;
+  Rigid3 estimated_camera_T_table;
+  Annotation truth_annotation;     // the slider block's true values
+  Annotation read_annotation;      // the slider reader's values (held where not found)
+  std::vector<bool> slider_found;  // #frames
+  double record_seconds = 0.0;     // render + track of the recording session [s]
+  double annotate_seconds = 0.0;   // render + read of the annotation session [s]
 };
 
 struct StageSeconds {
@@ -125,10 +133,28 @@ struct AnimatorRun {
 // never concurrently.
 using Progress = std::function<void(std::int64_t done, std::int64_t total)>;
 
+// Called once per take (and for the practice take, with practice = true) as soon as its sessions
+// are tracked and read, before anything that may fail later, so that a caller can keep the
+// results of the stages that finished.
+using TakeDone = std::function<void(const TakeRun& take, bool practice)>;
+
 // Runs participant `animator` of config.render.population through `config.run.takes` takes of
 // config.render.story (object config.render.object). Deterministic in the config, independent of
-// the thread count. Throws InputError for bad input (a missing story, too short takes, a take whose
-// tracking failed entirely), naming what is wrong.
-AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress = {});
+// the thread count. Throws InputError for bad input (a missing story, takes too short for the
+// montage), and a RunError when a take's tracking failed (fewer than run.min_tracked_share of its
+// frames estimated), naming the take.
+AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress = {},
+                        const TakeDone& take_done = {});
+
+// A failure of the work (exit code 1), as opposed to bad input.
+class RunError : public std::runtime_error {
+ public:
+  explicit RunError(const std::string& message) : std::runtime_error(message) {}
+};
+
+// Fills the poses of frames without an estimate (`estimated[i]` false) by interpolating between
+// the nearest estimated frames (the first or last estimate held at the ends). `poses` has
+// estimated.size() entries; at least one must be estimated.
+void FillGaps(std::vector<Rigid3>& poses, const std::vector<bool>& estimated);
 
 }  // namespace mmh::pipeline

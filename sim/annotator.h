@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/annotation.h"
+#include "core/cross_correlation.h"
 
 namespace mmh::sim {
 
@@ -88,9 +89,7 @@ struct AnnotationSession {
 AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorProfile& profile,
                                const AnnotatorOptions& options, std::uint64_t seed);
 
-// The lag [frames] in [0, max_lag] that maximises the correlation between `reference` and the
-// `delayed` copy of it (delayed(t) ≈ reference(t − lag)); parabolic refinement gives a fraction.
-double CrossCorrelationLag(std::span<const double> reference, std::span<const double> delayed,
-                           int max_lag);
+// CrossCorrelationLag (core/cross_correlation.h) estimates a session's lag.
+using mmh::CrossCorrelationLag;
 
 }  // namespace mmh::sim

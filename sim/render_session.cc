@@ -158,7 +158,7 @@ void RenderOptions::Validate(const std::string& prefix) const {
 RenderConfig RenderConfig::FromConfig(const Config& config) {
   config.RequireOnlySections({"render", "camera", "scene", "hand", "sensor", "motion", "population",
                               "performance", "annotator", "viewer", "study", "scorers", "montage",
-                              "track", "metrics"});
+                              "track", "metrics", "run", "tracker", "slider", "error_model"});
   RenderConfig c;
   c.render = config.Get<RenderOptions>("render");
   c.camera = config.Get<CameraPlacement>("camera");
@@ -266,14 +266,6 @@ struct Motion {
   std::optional<AnnotationSession> annotation;
 };
 
-// Resolves a story's proxy path: relative to the story file's folder.
-std::string StoryProxy(const std::string& story_file, const std::string& proxy) {
-  if (proxy.empty()) return "";
-  const std::filesystem::path path(proxy);
-  if (path.is_absolute()) return proxy;
-  return (std::filesystem::path(story_file).parent_path() / path).lexically_normal().string();
-}
-
 Motion ResolveMotion(const RenderConfig& config) {
   const RenderOptions& r = config.render;
   Motion motion;
@@ -290,7 +282,7 @@ Motion ResolveMotion(const RenderConfig& config) {
     const std::uint64_t seed = ParticipantSeed(config.population, r.animator);
     motion.take = PerformTake(story, r.object, motion.participant->animator, r.take,
                               config.performance, seed);
-    if (r.proxy.empty()) motion.proxy = StoryProxy(r.story, story.objects[r.object].proxy);
+    if (r.proxy.empty()) motion.proxy = StoryProxyFile(r.story, story, r.object);
     const int take_frames = motion.take->frames();
     motion.frames = r.frames == 0 ? take_frames : std::min(r.frames, take_frames);
     if (r.session == RenderSession::kRecording) {
@@ -298,15 +290,9 @@ Motion ResolveMotion(const RenderConfig& config) {
       motion.slider.assign(take_frames, config.annotator.start_value);
     } else {
       // The take plays on screen; the animator's hand is on the block; the proxy rests.
-      AnnotatorOptions annotator = config.annotator;
-      annotator.frame_rate = config.performance.frame_rate;
-      motion.annotation =
-          AnnotateTake(motion.take->quality.quality, motion.participant->annotator, annotator,
-                       DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(r.object),
-                                         static_cast<std::uint64_t>(r.take)}));
+      motion.annotation = AnnotateStoryTake(config, *motion.participant, *motion.take);
       motion.slider = motion.annotation->slider;
-      motion.table_T_proxy.assign(take_frames, Rigid3(Eigen::Quaterniond::Identity(),
-                                                      Eigen::Vector3d(kRestingProxyX, 0, 0)));
+      motion.table_T_proxy.assign(take_frames, RestingTableTProxy());
       motion.hand = TableTopScene::Hand::kOnSlider;
     }
     return motion;
@@ -384,6 +370,28 @@ void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
 }
 
 }  // namespace
+
+std::string StoryProxyFile(const std::string& story_file, const Story& story, int object) {
+  const std::string& proxy = story.objects.at(object).proxy;
+  if (proxy.empty()) return "";
+  const std::filesystem::path path(proxy);
+  if (path.is_absolute()) return proxy;
+  return (std::filesystem::path(story_file).parent_path() / path).lexically_normal().string();
+}
+
+AnnotationSession AnnotateStoryTake(const RenderConfig& config, const Participant& participant,
+                                    const PerformedTake& take) {
+  AnnotatorOptions annotator = config.annotator;
+  annotator.frame_rate = config.performance.frame_rate;
+  const std::uint64_t seed = ParticipantSeed(config.population, participant.index);
+  return AnnotateTake(take.quality.quality, participant.annotator, annotator,
+                      DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(take.object),
+                                        static_cast<std::uint64_t>(take.take)}));
+}
+
+Rigid3 RestingTableTProxy() {
+  return Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(kRestingProxyX, 0, 0));
+}
 
 RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
                              const std::function<void(int, int)>& progress) {

@@ -1,0 +1,160 @@
+// `mmh run`: one animator end to end (pipeline/animator_run.h), its files (pipeline/run_output.h).
+#include "cli/run_command.h"
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "cli/command_registry.h"
+#include "cli/compose_command.h"
+#include "cli/provenance.h"
+#include "core/atomic_file.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "pipeline/animator_run.h"
+#include "pipeline/run_metrics.h"
+#include "pipeline/run_output.h"
+
+namespace mmh::cli {
+namespace {
+
+struct RunArgs {
+  CommonFlags common;
+  int animator = -1;
+  long long seed = -1;
+};
+
+// A progress bar on a terminal (stderr), nothing otherwise.
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, std::string label) : enabled_(enabled), label_(std::move(label)) {}
+  void Update(std::int64_t done, std::int64_t total) {
+    if (!enabled_ || total <= 0) return;
+    const int width = 30;
+    const int filled = static_cast<int>(width * done / total);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::fprintf(stderr, "\r%s [%s%s] %lld / %lld frames, %.0f frames/s ", label_.c_str(),
+                 std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+                 static_cast<long long>(done), static_cast<long long>(total),
+                 seconds > 0 ? done / seconds : 0.0);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_;
+  std::string label_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animator,
+                                  const std::filesystem::path& out, bool progress_bar,
+                                  const std::vector<std::string>& argv, int threads) {
+  EnsureDirectory(out);
+  const nlohmann::json resolved = config.ToJson();
+  // The resolved config first: whatever fails later, the results beside it say what ran.
+  WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
+  ProgressBar bar(progress_bar, "run: animator " + std::to_string(animator));
+  pipeline::AnimatorRun run;
+  try {
+    run = pipeline::RunAnimator(
+        config, animator, [&](std::int64_t done, std::int64_t total) { bar.Update(done, total); },
+        [&](const pipeline::TakeRun& take, bool practice) {
+          pipeline::WriteTakeRun(out, take, practice);
+        });
+  } catch (...) {
+    // The takes that finished are on disk; say what ran.
+    WriteFileAtomically(out / "run.json",
+                        Provenance(argv, resolved, threads, {{"failed", true}}).dump(2) + "\n");
+    throw;
+  }
+  pipeline::WriteAnimatorRun(out, run);
+  WriteFileAtomically(
+      out / "run.json",
+      Provenance(argv, resolved, threads, pipeline::SecondsToJson(run)).dump(2) + "\n");
+  return run;
+}
+
+namespace {
+
+void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
+  Config config = LoadConfig(args.common);
+  if (args.seed >= 0) config.Set("population.seed=" + std::to_string(args.seed));
+  if (args.animator >= 0) config.Set("render.animator=" + std::to_string(args.animator));
+  const pipeline::RunConfig run_config = pipeline::RunConfig::FromConfig(config);
+  const auto threads = LimitThreads(args.common.threads);
+  const std::filesystem::path out = args.common.out_dir;
+  const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
+  const pipeline::AnimatorRun run = RunScenario(run_config, run_config.render.render.animator, out,
+                                                bar, argv, args.common.threads);
+  if (args.common.quiet) return;
+  const nlohmann::json& m = run.metrics;
+  const nlohmann::json seconds = pipeline::SecondsToJson(run);
+  std::printf("run: animator %d, %zu takes of %s (%s fidelity)\n", run.participant.index,
+              run.takes.size(), run_config.render.render.story.c_str(),
+              EnumName(run_config.run.fidelity));
+  for (const nlohmann::json& t : m["takes"]) {
+    std::printf(
+        "  take %d: %d frames, quality %.3f; tracking %.1f %% within %.0f deg/%.0f mm, median "
+        "%.2f deg / %.2f mm, %d lost; slider RMSE %.3f\n",
+        t["take"].get<int>(), t["frames"].get<int>(), t["mean_quality"].get<double>(),
+        100 * t["tracking"]["success_rate"].get<double>(), run_config.metrics.success_rotation_deg,
+        1000 * run_config.metrics.success_translation,
+        t["tracking"]["rotation_deg"]["median"].get<double>(),
+        1000 * t["tracking"]["translation_m"]["median"].get<double>(),
+        t["tracking"]["lost"].get<int>(), t["annotation"]["rmse"].get<double>());
+  }
+  const nlohmann::json& mt = m["montage"]["tracked"];
+  std::printf(
+      "  montage: %d frames, %d segments (shortest %d), quality %.3f (best take %+.3f), "
+      "constraint +%.2f %%, label agreement with the ground-truth montage %.1f %%\n",
+      mt["frames"].get<int>(), mt["segments"].get<int>(), mt["shortest_segment_frames"].get<int>(),
+      mt["mean_quality"].get<double>(), mt["quality_gain_over_best_take"].get<double>(),
+      mt["constraint_increase_percent"].get<double>(),
+      100 * m["montage"]["tracked_vs_truth"]["label_agreement"].get<double>());
+  std::printf(
+      "  time: %.1f s total (record %.1f s, annotate %.1f s, compose %.2f s), %.0f frames/s "
+      "through render and track\n",
+      seconds["total"].get<double>(), seconds["record"].get<double>(),
+      seconds["annotate"].get<double>(), seconds["compose"].get<double>(),
+      seconds["render_track_frames_per_second"].get<double>());
+  std::printf(
+      "written: %s/{metrics.json, metrics.csv, tracking_frames.csv, seams.csv, takes/, "
+      "montage/, montage_truth/, config.resolved.json, run.json}\n",
+      out.string().c_str());
+}
+
+}  // namespace
+
+void AddRunCommand(CLI::App& app, const std::vector<std::string>& argv) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "One animator end to end: performance -> sensor -> tracker -> montage -> metrics");
+  cmd->add_option("--config", args->common.config_file,
+                  "JSON config (e.g. configs/soldier.json): render sections, tracker, slider, "
+                  "montage, metrics, error_model, run")
+      ->required();
+  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
+      ->take_all();
+  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
+  cmd->add_option("--animator", args->animator, "Participant index (sets render.animator)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--seed", args->seed, "Population seed (sets population.seed)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  cmd->callback([args, argv] { RunRun(*args, argv); });
+}
+
+MMH_REGISTER_COMMAND(45, AddRunCommand);
+
+}  // namespace mmh::cli

@@ -1,0 +1,439 @@
+#include "pipeline/animator_run.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <mutex>
+
+#include "core/error.h"
+#include "core/options.h"
+#include "pipeline/run_metrics.h"
+#include "sim/kinect_sensor.h"
+#include "sim/props.h"
+#include "sim/random.h"
+#include "sim/viewer.h"
+#include "track/frame_source.h"
+#include "track/setup.h"
+#include "track/track_session.h"
+
+namespace mmh::pipeline {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+constexpr std::pair<Fidelity, const char*> kFidelityNames[] = {{Fidelity::kFull, "full"},
+                                                               {Fidelity::kFast, "fast"}};
+
+// What the tracker is told about the setup, as a user calibrates it once before recording: the
+// camera's pose above the table (the tape marks), the play area and the Like box. `mmh render`
+// writes the same into scene.json.
+track::TrackSetup SetupOf(const sim::RenderConfig& config, const Rigid3& camera_T_table) {
+  track::TrackSetup setup;
+  setup.camera_T_table = camera_T_table;
+  setup.play_area_width = config.scene.play_area_width;
+  setup.play_area_depth = config.scene.play_area_depth;
+  setup.like_box_center_x = config.scene.like_box_center_x;
+  setup.like_box_center_y = config.scene.like_box_center_y;
+  setup.like_box_length = config.scene.like_box_length;
+  setup.like_box_width = config.scene.like_box_width;
+  setup.slider_block_size = sim::kSliderBlockSize;
+  return setup;
+}
+
+// One session to render and track: the proxy and slider per frame, and what the hand holds.
+struct SessionJob {
+  int take_slot = 0;  // index into the take list (the practice take first, when there is one)
+  bool annotation = false;
+  const TriangleMesh* model = nullptr;
+  std::string model_name;
+  std::vector<Rigid3> table_T_proxy;
+  std::vector<double> slider;
+  sim::TableTopScene::Hand hand = sim::TableTopScene::Hand::kOnProxy;
+  // Results.
+  track::TrackRun run;
+  Rigid3 camera_T_table;  // the true one (for the ground truth in the camera frame)
+  double seconds = 0.0;
+};
+
+// Renders the session frame by frame (incremental mode: only what moves is re-cast) and hands
+// each frame to the tracker; nothing is stored but the tracker's results.
+void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOptions& tracker,
+                const track::SliderReaderOptions& slider, SessionJob& job,
+                const std::function<void()>& frame_done) {
+  const auto start = Clock::now();
+  sim::TableTopScene scene(render, *job.model);
+  sim::KinectSensor sensor(render.sensor, &scene.scene(), scene.table_T_camera());
+  job.camera_T_table = sensor.world_T_depth_camera().Inverse();
+  const int frames = static_cast<int>(job.table_T_proxy.size());
+  track::CallbackFrameSource source(
+      [&](int i, RgbdFrame* frame) {
+        if (i >= frames) return false;
+        scene.SetFrame(job.table_T_proxy[i], job.slider[i], job.hand);
+        sensor.Render(i, render.render.mode, frame);
+        return true;
+      },
+      "simulated session", frames);
+  track::TrackConfig config;
+  config.tracker = tracker;
+  config.slider = slider;
+  config.run.output_frame = track::OutputFrame::kTable;
+  config.run.slider = job.annotation;
+  config.run.proxy = !job.annotation;
+  job.run =
+      track::RunTracking(source, *job.model, job.model_name, SetupOf(render, job.camera_T_table),
+                         true, config, [&](int, int) { frame_done(); });
+  job.seconds = SecondsSince(start);
+}
+
+// The recorded take as the system has it: poses in the tracker's table frame, lost frames filled.
+void CollectRecording(const SessionJob& job, const RunOptions& options, TakeRun& take) {
+  const int frames = static_cast<int>(job.run.frames.size());
+  const double fps = take.performed.table_T_proxy.size() > 1
+                         ? 1.0 / (take.performed.table_T_proxy.timestamps[1] -
+                                  take.performed.table_T_proxy.timestamps[0])
+                         : 30.0;
+  take.camera_T_table = job.camera_T_table;
+  take.estimated_camera_T_table = job.run.camera_T_table.value_or(job.camera_T_table);
+  const Rigid3 table_T_camera = take.estimated_camera_T_table.Inverse();
+  std::vector<Rigid3> poses(frames);
+  std::vector<bool> estimated(frames, false);
+  take.status.resize(frames);
+  for (int i = 0; i < frames; ++i) {
+    const track::TrackFrameResult& r = job.run.frames[i];
+    take.status[i] = r.status;
+    if (r.status != track::TrackStatus::kLost) {
+      poses[i] = table_T_camera * r.camera_T_proxy;
+      estimated[i] = true;
+    }
+  }
+  const int estimated_count =
+      static_cast<int>(std::count(estimated.begin(), estimated.end(), true));
+  take.estimated_share = frames > 0 ? static_cast<double>(estimated_count) / frames : 0.0;
+  if (estimated_count > 0) FillGaps(poses, estimated);
+  take.tracked.poses = std::move(poses);
+  take.tracked.timestamps.resize(frames);
+  for (int i = 0; i < frames; ++i) take.tracked.timestamps[i] = i / fps;
+  take.record_seconds = job.seconds;
+  (void)options;
+}
+
+void CollectAnnotation(const SessionJob& job, TakeRun& take) {
+  take.read_annotation = job.run.annotation;
+  take.slider_found.resize(job.run.slider.size());
+  for (size_t i = 0; i < job.run.slider.size(); ++i) take.slider_found[i] = job.run.slider[i].found;
+  take.annotate_seconds = job.seconds;
+}
+
+// Stand-ins for the sessions in fast fidelity: the error model applied to the ground truth.
+void SimulateSessions(const RunConfig& config, std::uint64_t seed, TakeRun& take) {
+  const SimulatedTracking tracking = SimulateTracking(
+      take.performed.table_T_proxy, config.error_model,
+      sim::DeriveSeed(seed, {0x7472ull, static_cast<std::uint64_t>(take.performed.object),
+                             static_cast<std::uint64_t>(take.take)}));
+  const int frames = take.performed.frames();
+  std::vector<Rigid3> poses = tracking.tracked.poses;
+  std::vector<bool> estimated(frames);
+  for (int i = 0; i < frames; ++i) estimated[i] = tracking.status[i] != track::TrackStatus::kLost;
+  const int estimated_count =
+      static_cast<int>(std::count(estimated.begin(), estimated.end(), true));
+  take.estimated_share = frames > 0 ? static_cast<double>(estimated_count) / frames : 0.0;
+  if (estimated_count > 0) FillGaps(poses, estimated);
+  take.tracked.poses = std::move(poses);
+  take.tracked.timestamps = take.performed.table_T_proxy.timestamps;
+  take.status = tracking.status;
+  if (!take.truth_annotation.values.empty()) {
+    const SimulatedReading reading = SimulateSliderReading(
+        take.truth_annotation, config.error_model,
+        sim::DeriveSeed(seed, {0x736cull, static_cast<std::uint64_t>(take.performed.object),
+                               static_cast<std::uint64_t>(take.take)}));
+    take.read_annotation = reading.read;
+    take.slider_found = reading.found;
+  }
+}
+
+// Per montage frame: the take it shows and that take's frame (for carrying latent quality).
+std::vector<double> MontageQuality(const montage::Montage& m, const std::vector<TakeRun>& takes) {
+  std::vector<std::vector<double>> quality;
+  for (const TakeRun& t : takes) quality.push_back(t.performed.quality.quality);
+  std::vector<int> take_of_frame, source_frame;
+  for (const montage::MontageSegment& s : m.segments) {
+    for (int f = s.source_first; f <= s.source_last; ++f) {
+      take_of_frame.push_back(s.take);
+      source_frame.push_back(f);
+    }
+  }
+  return sim::CompositeQuality(quality, take_of_frame, source_frame);
+}
+
+}  // namespace
+
+std::span<const std::pair<Fidelity, const char*>> EnumNames(Fidelity) { return kFidelityNames; }
+
+void RunOptions::Validate(const std::string& prefix) const {
+  if (takes < 2) {
+    ThrowBadValue(prefix + ".takes", std::to_string(takes),
+                  "at least 2 takes (a montage needs two)");
+  }
+  if (!(min_tracked_share >= 0.0 && min_tracked_share <= 1.0)) {
+    ThrowBadValue(prefix + ".min_tracked_share", FormatNumber(min_tracked_share),
+                  "a share in [0, 1]");
+  }
+}
+
+RunConfig RunConfig::FromConfig(const Config& config,
+                                const std::vector<std::string>& extra_sections) {
+  std::vector<std::string> sections = {"render",    "camera",      "scene",      "hand",
+                                       "sensor",    "motion",      "population", "performance",
+                                       "annotator", "tracker",     "slider",     "montage",
+                                       "metrics",   "error_model", "run"};
+  sections.insert(sections.end(), extra_sections.begin(), extra_sections.end());
+  config.RequireOnlySections(sections);
+  RunConfig c;
+  c.render = sim::RenderConfig::FromConfig(config);
+  c.tracker = config.Get<track::ProxyTrackerOptions>("tracker");
+  c.slider = config.Get<track::SliderReaderOptions>("slider");
+  c.montage = config.Get<montage::ComposeOptions>("montage");
+  c.metrics = config.Get<metrics::PoseErrorOptions>("metrics");
+  c.error_model = config.Get<ErrorModelOptions>("error_model");
+  c.run = config.Get<RunOptions>("run");
+  if (c.render.render.story.empty()) {
+    ThrowBadValue("render.story", "\"\"", "a story file (e.g. configs/stories/soldier.json)");
+  }
+  if (std::abs(c.render.performance.frame_rate - c.render.sensor.frame_rate) > 1e-9) {
+    ThrowBadValue("performance.frame_rate", FormatNumber(c.render.performance.frame_rate),
+                  "the sensor's frame rate (sensor.frame_rate = " +
+                      FormatNumber(c.render.sensor.frame_rate) + ")");
+  }
+  return c;
+}
+
+nlohmann::json RunConfig::ToJson() const {
+  nlohmann::json j = render.ToJson();
+  j["tracker"] = mmh::ToJson(tracker);
+  j["slider"] = mmh::ToJson(slider);
+  j["montage"] = mmh::ToJson(montage);
+  j["metrics"] = mmh::ToJson(metrics);
+  j["error_model"] = mmh::ToJson(error_model);
+  j["run"] = mmh::ToJson(run);
+  return j;
+}
+
+void FillGaps(std::vector<Rigid3>& poses, const std::vector<bool>& estimated) {
+  const int n = static_cast<int>(poses.size());
+  int previous = -1;
+  for (int i = 0; i < n; ++i) {
+    if (!estimated[i]) continue;
+    if (previous < 0) {
+      for (int j = 0; j < i; ++j) poses[j] = poses[i];
+    } else {
+      for (int j = previous + 1; j < i; ++j) {
+        poses[j] = Interpolate(poses[previous], poses[i],
+                               static_cast<double>(j - previous) / (i - previous));
+      }
+    }
+    previous = i;
+  }
+  if (previous < 0) throw std::logic_error("FillGaps: no estimated frame");
+  for (int j = previous + 1; j < n; ++j) poses[j] = poses[previous];
+}
+
+AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress,
+                        const TakeDone& take_done) {
+  const auto start = Clock::now();
+  const sim::RenderConfig& render = config.render;
+  const RunOptions& options = config.run;
+  AnimatorRun result;
+  if (animator < 0) ThrowBadValue("animator", std::to_string(animator), "an index >= 0");
+
+  // Perform: the practice take, the takes, and the annotation sessions (cheap; sequential).
+  auto t0 = Clock::now();
+  const sim::Story story = sim::LoadStory(render.render.story, render.scene);
+  const int object = render.render.object;
+  if (object < 0 || object >= static_cast<int>(story.objects.size())) {
+    ThrowBadValue("render.object", std::to_string(object),
+                  "an object of " + render.render.story + " (0.." +
+                      std::to_string(story.objects.size() - 1) + ")");
+  }
+  result.participant = sim::DrawParticipant(render.population, animator);
+  const std::uint64_t seed = sim::ParticipantSeed(render.population, animator);
+  std::optional<sim::Story> practice_story;
+  const int practice_takes = options.practice.empty() ? 0 : 1;
+  std::vector<TakeRun> takes;  // the practice take first
+  if (practice_takes) {
+    practice_story = sim::LoadStory(options.practice, render.scene);
+    TakeRun t;
+    t.take = 0;
+    t.performed = sim::PerformTake(*practice_story, 0, result.participant.animator, 0,
+                                   render.performance, seed);
+    takes.push_back(std::move(t));
+  }
+  for (int k = 0; k < options.takes; ++k) {
+    TakeRun t;
+    t.take = practice_takes + k;
+    t.performed = sim::PerformTake(story, object, result.participant.animator, t.take,
+                                   render.performance, seed);
+    t.annotation = sim::AnnotateStoryTake(render, result.participant, t.performed);
+    takes.push_back(std::move(t));
+  }
+  // render.frames (when set) shortens every session: a quick look, or a short regression test.
+  for (TakeRun& t : takes) {
+    const int frames = render.render.frames == 0
+                           ? t.performed.frames()
+                           : std::min(render.render.frames, t.performed.frames());
+    t.truth = t.performed.table_T_proxy;
+    t.truth.timestamps.resize(frames);
+    t.truth.poses.resize(frames);
+    if (!t.annotation.slider.empty()) {
+      t.truth_annotation = t.annotation.SliderAnnotation(render.performance.frame_rate);
+      t.truth_annotation.timestamps.resize(frames);
+      t.truth_annotation.values.resize(frames);
+    }
+  }
+  result.seconds.perform = SecondsSince(t0);
+
+  if (options.fidelity == Fidelity::kFull) {
+    // Every session is its own job (scene, sensor, tracker); jobs run in parallel and each renders
+    // its frames in order, so the results do not depend on the thread count.
+    std::vector<TriangleMesh> models;
+    std::vector<std::string> model_names;
+    const std::string main_proxy = render.render.proxy.empty()
+                                       ? sim::StoryProxyFile(render.render.story, story, object)
+                                       : render.render.proxy;
+    models.push_back(sim::LoadProxyModel(main_proxy, render.render.proxy_scale));
+    model_names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
+    if (practice_takes) {
+      const std::string practice_proxy = sim::StoryProxyFile(options.practice, *practice_story, 0);
+      models.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
+      model_names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
+    }
+    std::vector<SessionJob> jobs;
+    std::int64_t total_frames = 0;
+    for (size_t slot = 0; slot < takes.size(); ++slot) {
+      const TakeRun& t = takes[slot];
+      const bool is_practice = practice_takes && slot == 0;
+      const int model = is_practice ? 1 : 0;
+      const int frames = static_cast<int>(t.truth.poses.size());
+      SessionJob recording;
+      recording.take_slot = static_cast<int>(slot);
+      recording.model = &models[model];
+      recording.model_name = model_names[model];
+      recording.table_T_proxy = t.truth.poses;
+      recording.slider.assign(frames, render.annotator.start_value);
+      jobs.push_back(std::move(recording));
+      total_frames += frames;
+      if (!is_practice) {
+        SessionJob annotation;
+        annotation.take_slot = static_cast<int>(slot);
+        annotation.annotation = true;
+        annotation.model = &models[model];
+        annotation.model_name = model_names[model];
+        annotation.table_T_proxy.assign(frames, sim::RestingTableTProxy());
+        annotation.slider = t.truth_annotation.values;
+        annotation.hand = sim::TableTopScene::Hand::kOnSlider;
+        jobs.push_back(std::move(annotation));
+        total_frames += frames;
+      }
+    }
+    // Longest jobs first: the recordings (tracking costs more than slider reading).
+    std::vector<int> order(jobs.size());
+    for (size_t i = 0; i < jobs.size(); ++i) order[i] = static_cast<int>(i);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return !jobs[a].annotation && jobs[b].annotation; });
+    std::atomic<std::int64_t> done{0};
+    std::mutex progress_mutex;
+    auto frame_done = [&] {
+      const std::int64_t d = ++done;
+      if (progress && (d % 32 == 0 || d == total_frames)) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        progress(d, total_frames);
+      }
+    };
+    t0 = Clock::now();
+    tbb::parallel_for(0, static_cast<int>(order.size()), 1, [&](int i) {
+      RunSession(render, config.tracker, config.slider, jobs[order[i]], frame_done);
+    });
+    const double sessions_seconds = SecondsSince(t0);
+    double record_cpu = 0.0, annotate_cpu = 0.0;
+    for (const SessionJob& job : jobs) {
+      TakeRun& t = takes[job.take_slot];
+      if (job.annotation) {
+        CollectAnnotation(job, t);
+        annotate_cpu += job.seconds;
+      } else {
+        CollectRecording(job, options, t);
+        record_cpu += job.seconds;
+      }
+    }
+    // The sessions ran interleaved: split their wall clock in proportion to their thread time.
+    const double cpu = record_cpu + annotate_cpu;
+    result.seconds.record = cpu > 0 ? sessions_seconds * record_cpu / cpu : 0.0;
+    result.seconds.annotate = cpu > 0 ? sessions_seconds * annotate_cpu / cpu : 0.0;
+    result.rendered_frames = static_cast<int>(total_frames);
+  } else {
+    t0 = Clock::now();
+    for (TakeRun& t : takes) {
+      const Trajectory full = t.performed.table_T_proxy;
+      t.performed.table_T_proxy = t.truth;  // the error model sees the (possibly shortened) take
+      SimulateSessions(config, seed, t);
+      t.performed.table_T_proxy = full;
+      if (progress) progress(&t - takes.data() + 1, static_cast<std::int64_t>(takes.size()));
+    }
+    result.seconds.record = SecondsSince(t0);
+  }
+
+  if (practice_takes) {
+    result.practice = std::move(takes.front());
+    takes.erase(takes.begin());
+  }
+  result.takes = std::move(takes);
+  if (take_done) {
+    if (result.practice) take_done(*result.practice, true);
+    for (const TakeRun& t : result.takes) take_done(t, false);
+  }
+  auto check_tracked = [&](const TakeRun& t, const std::string& what) {
+    if (t.estimated_share < options.min_tracked_share) {
+      throw RunError(what + ": tracking failed: " + FormatNumber(100.0 * t.estimated_share) +
+                     " % of its " + std::to_string(t.status.size()) +
+                     " frames have a pose, run.min_tracked_share asks for at least " +
+                     FormatNumber(100.0 * options.min_tracked_share) +
+                     " %; see its status.csv for the reasons");
+    }
+  };
+  if (result.practice) check_tracked(*result.practice, "practice take");
+  for (const TakeRun& t : result.takes) check_tracked(t, "take " + std::to_string(t.take));
+
+  // Compose: the system's montage (tracked takes, read annotations) and the ground truth's.
+  t0 = Clock::now();
+  std::vector<Trajectory> tracked, truth;
+  std::vector<Annotation> read, truth_annotations;
+  std::vector<std::string> names;
+  for (const TakeRun& t : result.takes) {
+    tracked.push_back(t.tracked);
+    truth.push_back(t.truth);
+    read.push_back(t.read_annotation);
+    truth_annotations.push_back(t.truth_annotation);
+    names.push_back("take " + std::to_string(t.take));
+  }
+  result.montage = montage::Compose(tracked, read, config.montage, names);
+  result.truth_montage = montage::Compose(truth, truth_annotations, config.montage, names);
+  result.montage_quality = MontageQuality(result.montage, result.takes);
+  result.truth_montage_quality = MontageQuality(result.truth_montage, result.takes);
+  result.seconds.compose = SecondsSince(t0);
+
+  // metrics.json holds no timings (same config and seed, same bytes); they go to run.json.
+  t0 = Clock::now();
+  result.metrics = ComputeRunMetrics(config, result);
+  result.seconds.metrics = SecondsSince(t0);
+  result.seconds.total = SecondsSince(start);
+  return result;
+}
+
+}  // namespace mmh::pipeline

@@ -1,0 +1,273 @@
+#include "pipeline/regress.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "core/error.h"
+#include "pipeline/run_metrics.h"
+
+namespace mmh::pipeline {
+
+namespace {
+
+Better ParseBetter(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_string()) ThrowBadValue(where, j.dump(), "\"higher\", \"lower\" or \"either\"");
+  const std::string s = j.get<std::string>();
+  if (s == "higher") return Better::kHigher;
+  if (s == "lower") return Better::kLower;
+  if (s == "either") return Better::kEither;
+  ThrowBadValue(where, "\"" + s + "\"", "\"higher\", \"lower\" or \"either\"");
+}
+
+const char* BetterName(Better better) {
+  switch (better) {
+    case Better::kHigher:
+      return "higher";
+    case Better::kLower:
+      return "lower";
+    case Better::kEither:
+      return "either";
+  }
+  return "either";
+}
+
+const nlohmann::json& Require(const nlohmann::json& object, const std::string& key,
+                              const std::string& where) {
+  const auto it = object.find(key);
+  if (it == object.end()) ThrowBadValue(where + "." + key, "nothing", "a value (missing key)");
+  return *it;
+}
+
+void RequireOnlyKeys(const nlohmann::json& object, const std::vector<std::string>& keys,
+                     const std::string& where) {
+  for (const auto& [key, value] : object.items()) {
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+      std::string expected;
+      for (const std::string& k : keys) expected += (expected.empty() ? "" : ", ") + k;
+      ThrowBadValue(where + "." + key, "an unknown key", "one of " + expected);
+    }
+  }
+}
+
+double RequireNumber(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_number()) ThrowBadValue(where, j.dump(), "a number");
+  const double v = j.get<double>();
+  RequireFinite(v, where);
+  return v;
+}
+
+}  // namespace
+
+Baseline ReadBaseline(const std::filesystem::path& folder) {
+  Baseline b;
+  b.file = folder / "baseline.json";
+  std::ifstream in(b.file);
+  if (!in) ThrowBadValue(b.file.string(), "a missing or unreadable file", "a baseline.json");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    ThrowBadValue(b.file.string(), std::string("invalid JSON (") + e.what() + ")", "a JSON object");
+  }
+  const std::string file = b.file.string();
+  if (!j.is_object()) ThrowBadValue(file, j.dump().substr(0, 40), "a JSON object");
+  RequireOnlyKeys(j, {"root", "scenarios", "comment"}, file);
+  const nlohmann::json& root = Require(j, "root", file);
+  if (!root.is_string()) ThrowBadValue(file + ": root", root.dump(), "a folder path");
+  b.root = (folder / root.get<std::string>()).lexically_normal();
+  const nlohmann::json& scenarios = Require(j, "scenarios", file);
+  if (!scenarios.is_array() || scenarios.empty()) {
+    ThrowBadValue(file + ": scenarios", scenarios.dump().substr(0, 40), "a non-empty array");
+  }
+  for (size_t i = 0; i < scenarios.size(); ++i) {
+    const std::string where = file + ": scenarios[" + std::to_string(i) + "]";
+    const nlohmann::json& s = scenarios[i];
+    if (!s.is_object()) ThrowBadValue(where, s.dump().substr(0, 40), "an object");
+    RequireOnlyKeys(s, {"name", "config", "set", "config_hash", "metrics"}, where);
+    Scenario scenario;
+    const nlohmann::json& name = Require(s, "name", where);
+    const nlohmann::json& config = Require(s, "config", where);
+    if (!name.is_string() || name.get<std::string>().empty()) {
+      ThrowBadValue(where + ".name", name.dump(), "a non-empty name");
+    }
+    if (!config.is_string()) ThrowBadValue(where + ".config", config.dump(), "a config path");
+    scenario.name = name.get<std::string>();
+    scenario.config = b.root / config.get<std::string>();
+    if (s.contains("set")) {
+      if (!s["set"].is_array()) ThrowBadValue(where + ".set", s["set"].dump(), "an array");
+      for (const nlohmann::json& set : s["set"]) {
+        if (!set.is_string()) ThrowBadValue(where + ".set", set.dump(), "key.path=value strings");
+        scenario.sets.push_back(set.get<std::string>());
+      }
+    }
+    if (s.contains("config_hash")) scenario.config_hash = s["config_hash"].get<std::string>();
+    const nlohmann::json& metrics = Require(s, "metrics", where);
+    // Empty for a new scenario: `mmh regress --update` fills it in.
+    if (!metrics.is_object()) {
+      ThrowBadValue(where + ".metrics", metrics.dump().substr(0, 40), "an object");
+    }
+    for (const auto& [key, m] : metrics.items()) {
+      const std::string mw = where + ".metrics." + key;
+      if (!m.is_object()) ThrowBadValue(mw, m.dump(), "an object {value, tolerance, ...}");
+      RequireOnlyKeys(m, {"value", "tolerance", "relative", "better"}, mw);
+      MetricTolerance t;
+      t.value = RequireNumber(Require(m, "value", mw), mw + ".value");
+      t.tolerance = RequireNumber(Require(m, "tolerance", mw), mw + ".tolerance");
+      RequireNonNegative(t.tolerance, mw + ".tolerance");
+      if (m.contains("relative")) {
+        if (!m["relative"].is_boolean())
+          ThrowBadValue(mw + ".relative", m["relative"].dump(), "true or false");
+        t.relative = m["relative"].get<bool>();
+      }
+      if (m.contains("better")) t.better = ParseBetter(m["better"], mw + ".better");
+      scenario.metrics.emplace_back(key, t);
+    }
+    for (const Scenario& other : b.scenarios) {
+      if (other.name == scenario.name) {
+        ThrowBadValue(where + ".name", "\"" + scenario.name + "\"", "a name not used before");
+      }
+    }
+    b.scenarios.push_back(std::move(scenario));
+  }
+  return b;
+}
+
+const char* VerdictName(Verdict verdict) {
+  switch (verdict) {
+    case Verdict::kPass:
+      return "pass";
+    case Verdict::kImproved:
+      return "improved";
+    case Verdict::kRegressed:
+      return "REGRESSED";
+    case Verdict::kMissing:
+      return "MISSING";
+  }
+  return "?";
+}
+
+std::vector<MetricComparison> CompareWithBaseline(const Scenario& scenario,
+                                                  const nlohmann::json& metrics) {
+  std::map<std::string, double> values;
+  for (const auto& [key, value] : FlattenMetrics(metrics)) values[key] = value;
+  std::vector<MetricComparison> out;
+  for (const auto& [key, t] : scenario.metrics) {
+    MetricComparison c;
+    c.scenario = scenario.name;
+    c.metric = key;
+    c.baseline = t;
+    const auto it = values.find(key);
+    if (it == values.end()) {
+      c.value = std::numeric_limits<double>::quiet_NaN();
+      c.verdict = Verdict::kMissing;
+      out.push_back(c);
+      continue;
+    }
+    c.value = it->second;
+    const double allowed = t.relative ? t.tolerance * std::abs(t.value) : t.tolerance;
+    const double change = c.value - t.value;
+    // A little slack for the decimal round trip of the baseline file.
+    if (std::abs(change) <= allowed + 1e-12 * std::max(1.0, std::abs(t.value))) {
+      c.verdict = Verdict::kPass;
+    } else if ((t.better == Better::kHigher && change > 0) ||
+               (t.better == Better::kLower && change < 0)) {
+      c.verdict = Verdict::kImproved;
+    } else {
+      c.verdict = Verdict::kRegressed;
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<std::pair<std::string, MetricTolerance>> DefaultBaselineMetrics(
+    const nlohmann::json& metrics) {
+  std::map<std::string, double> values;
+  for (const auto& [key, value] : FlattenMetrics(metrics)) values[key] = value;
+  std::vector<std::pair<std::string, MetricTolerance>> out;
+  auto add = [&](const std::string& key, double tolerance, bool relative, Better better) {
+    const auto it = values.find(key);
+    if (it == values.end()) return;
+    out.emplace_back(key, MetricTolerance{it->second, tolerance, relative, better});
+  };
+  // The ground truth (performance, annotator, compositor on true data): exact up to rounding.
+  // The tracker and the slider reader: small changes pass, and so does the montage built on them.
+  for (size_t k = 0; k < metrics["takes"].size(); ++k) {
+    const std::string p = "takes." + std::to_string(k) + ".";
+    add(p + "frames", 0, false, Better::kEither);
+    add(p + "mean_quality", 1e-9, true, Better::kEither);
+    add(p + "tracking.success_rate", 0.02, false, Better::kHigher);
+    add(p + "tracking.rotation_deg.median", 0.25, false, Better::kLower);
+    add(p + "tracking.translation_m.median", 0.0005, false, Better::kLower);
+    add(p + "tracking.longest_failure_frames", 5, false, Better::kLower);
+    add(p + "tracking.ape_translation_m.rmse", 0.002, false, Better::kLower);
+    add(p + "annotation.rmse", 0.05, false, Better::kLower);
+  }
+  add("practice.tracking.success_rate", 0.02, false, Better::kHigher);
+  add("tracking.success_rate", 0.01, false, Better::kHigher);
+  add("annotation.rmse", 0.03, false, Better::kLower);
+  add("montage.truth.total_cost", 1e-9, true, Better::kEither);
+  add("montage.truth.segments", 0, false, Better::kEither);
+  add("montage.truth.mean_quality", 1e-9, true, Better::kEither);
+  add("montage.tracked.total_cost", 0.05, true, Better::kEither);
+  add("montage.tracked.segments", 2, false, Better::kEither);
+  add("montage.tracked.mean_quality", 0.02, false, Better::kHigher);
+  add("montage.tracked.constraint_increase_percent", 1.0, false, Better::kLower);
+  add("montage.tracked_vs_truth.label_agreement", 0.05, false, Better::kHigher);
+  return out;
+}
+
+nlohmann::json ToJson(const Scenario& scenario) {
+  nlohmann::json j;
+  j["name"] = scenario.name;
+  j["config"] = scenario.config.string();
+  j["set"] = scenario.sets;
+  j["config_hash"] = scenario.config_hash;
+  nlohmann::json metrics = nlohmann::json::object();
+  for (const auto& [key, t] : scenario.metrics) {
+    metrics[key] = {{"value", t.value},
+                    {"tolerance", t.tolerance},
+                    {"relative", t.relative},
+                    {"better", BetterName(t.better)}};
+  }
+  j["metrics"] = metrics;
+  return j;
+}
+
+std::string FormatComparisons(const std::vector<MetricComparison>& comparisons) {
+  size_t width = 6;
+  for (const MetricComparison& c : comparisons) width = std::max(width, c.metric.size());
+  std::ostringstream out;
+  out << std::left << std::setw(10) << "scenario" << ' ' << std::setw(width) << "metric"
+      << std::right << std::setw(14) << "baseline" << std::setw(14) << "now" << std::setw(12)
+      << "tolerance"
+      << "  better  verdict\n";
+  for (const MetricComparison& c : comparisons) {
+    std::ostringstream tolerance;
+    tolerance << (c.baseline.relative ? "" : "±") << std::setprecision(3) << c.baseline.tolerance
+              << (c.baseline.relative ? " rel" : "");
+    out << std::left << std::setw(10) << c.scenario << ' ' << std::setw(width) << c.metric
+        << std::right << std::setw(14) << std::setprecision(6) << c.baseline.value << std::setw(14)
+        << c.value << std::setw(12) << tolerance.str() << "  " << std::left << std::setw(8)
+        << BetterName(c.baseline.better) << VerdictName(c.verdict) << '\n';
+  }
+  return out.str();
+}
+
+std::string ComparisonsToCsv(const std::vector<MetricComparison>& comparisons) {
+  std::ostringstream out;
+  out << "scenario,metric,baseline,value,tolerance,relative,better,verdict\n";
+  for (const MetricComparison& c : comparisons) {
+    out << c.scenario << ',' << c.metric << ',' << FormatNumber(c.baseline.value) << ','
+        << (std::isnan(c.value) ? "" : FormatNumber(c.value)) << ','
+        << FormatNumber(c.baseline.tolerance) << ',' << (c.baseline.relative ? "true" : "false")
+        << ',' << BetterName(c.baseline.better) << ',' << VerdictName(c.verdict) << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace mmh::pipeline

@@ -1,0 +1,80 @@
+// Regression against a committed baseline (`mmh regress`): a baseline folder holds baseline.json,
+// which names its scenarios (a run config and overrides) and, per scenario, the metrics to check
+// with their baseline value, tolerance and which direction is better. Each metric of a new run is
+// compared with its baseline: within tolerance it passes; beyond it in the better direction it
+// improved (a new baseline may be due); otherwise it regressed.
+//
+// baseline.json:
+//   {"root": "../..",                      folder that relative paths are relative to
+//    "scenarios": [{"name": "soldier",
+//                   "config": "configs/soldier.json",
+//                   "set": ["run.takes=3"],     optional overrides
+//                   "config_hash": "...",       of the resolved config the baseline ran
+//                   "metrics": {"takes.0.tracking.success_rate":
+//                                 {"value": 0.99, "tolerance": 0.02, "relative": false,
+//                                  "better": "higher"}, ...}}]}
+// "better" is "higher", "lower" or "either" (any change beyond the tolerance is a regression);
+// a relative tolerance is a share of |value|.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace mmh::pipeline {
+
+enum class Better { kHigher, kLower, kEither };
+
+struct MetricTolerance {
+  double value = 0.0;
+  double tolerance = 0.0;
+  bool relative = false;
+  Better better = Better::kEither;
+};
+
+struct Scenario {
+  std::string name;
+  std::filesystem::path config;  // resolved against the baseline's root
+  std::vector<std::string> sets;
+  std::string config_hash;
+  std::vector<std::pair<std::string, MetricTolerance>> metrics;
+};
+
+struct Baseline {
+  std::filesystem::path file;  // baseline.json
+  std::filesystem::path root;  // relative paths in scenarios and their configs resolve here
+  std::vector<Scenario> scenarios;
+};
+
+// Reads `folder`/baseline.json (InputError naming the file and key for anything malformed).
+Baseline ReadBaseline(const std::filesystem::path& folder);
+
+enum class Verdict { kPass, kImproved, kRegressed, kMissing };
+const char* VerdictName(Verdict verdict);
+
+struct MetricComparison {
+  std::string scenario;
+  std::string metric;
+  MetricTolerance baseline;
+  double value = 0.0;  // the new run's (NaN when missing)
+  Verdict verdict = Verdict::kPass;
+};
+
+// Compares a run's metrics.json with a scenario's baseline metrics.
+std::vector<MetricComparison> CompareWithBaseline(const Scenario& scenario,
+                                                  const nlohmann::json& metrics);
+
+// The metrics a new baseline checks, with the harness's default tolerances (docs/pipeline.md):
+// the ground truth (performances, ground-truth montage) almost exactly, the tracker and the
+// montage from tracked data within tolerances that absorb small changes.
+std::vector<std::pair<std::string, MetricTolerance>> DefaultBaselineMetrics(
+    const nlohmann::json& metrics);
+
+nlohmann::json ToJson(const Scenario& scenario);
+
+// A printable table and a tidy CSV of comparisons.
+std::string FormatComparisons(const std::vector<MetricComparison>& comparisons);
+std::string ComparisonsToCsv(const std::vector<MetricComparison>& comparisons);
+
+}  // namespace mmh::pipeline

@@ -1,0 +1,129 @@
+#include "pipeline/animator_run.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "core/config.h"
+#include "core/error.h"
+#include "tests/test_util.h"
+
+namespace mmh::pipeline {
+namespace {
+
+using test_util::ErrorOf;
+
+// A short Soldier scenario: `frames` frames of `takes` takes (the beginning of each take).
+RunConfig ShortConfig(Fidelity fidelity, int frames, int takes = 2) {
+  Config config;
+  config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  config.Set("scene.props=castle");
+  config.Set("render.frames=" + std::to_string(frames));
+  config.Set("run.takes=" + std::to_string(takes));
+  config.Set(std::string("run.fidelity=") + (fidelity == Fidelity::kFull ? "full" : "fast"));
+  return RunConfig::FromConfig(config);
+}
+
+TEST(FillGapsTest, InterpolatesBetweenEstimatesAndHoldsAtTheEnds) {
+  std::vector<Rigid3> poses(6);
+  const Rigid3 a(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.0, 0, 0));
+  const Rigid3 b(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ())),
+                 Eigen::Vector3d(0.3, 0, 0));
+  poses[1] = a;
+  poses[4] = b;
+  FillGaps(poses, {false, true, false, false, true, false});
+  EXPECT_NEAR(poses[0].translation.x(), 0.0, 1e-15);
+  EXPECT_NEAR(poses[2].translation.x(), 0.1, 1e-12);
+  EXPECT_NEAR(poses[3].translation.x(), 0.2, 1e-12);
+  EXPECT_NEAR(RotationAngle(poses[3].rotation, Eigen::Quaterniond::Identity()), 0.2, 1e-12);
+  EXPECT_NEAR(poses[5].translation.x(), 0.3, 1e-15);
+}
+
+TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
+  const RunConfig config = ShortConfig(Fidelity::kFast, 0, 3);
+  const AnimatorRun a = RunAnimator(config, 2);
+  const AnimatorRun b = RunAnimator(config, 2);
+  EXPECT_EQ(a.metrics.dump(), b.metrics.dump());
+  ASSERT_EQ(a.takes.size(), 3u);
+  EXPECT_EQ(a.rendered_frames, 0);
+  for (const TakeRun& t : a.takes) {
+    EXPECT_GT(t.truth.poses.size(), 1000u);  // whole Soldier takes
+    EXPECT_EQ(t.tracked.poses.size(), t.truth.poses.size());
+    EXPECT_EQ(t.read_annotation.values.size(), t.truth.poses.size());
+  }
+  EXPECT_EQ(a.montage_quality.size(), a.montage.trajectory.poses.size());
+  // Tracker-sized errors barely change the montage.
+  EXPECT_GT(a.metrics["montage"]["tracked_vs_truth"]["label_agreement"].get<double>(), 0.8);
+  // The other animator's run differs.
+  EXPECT_NE(RunAnimator(config, 3).metrics.dump(), a.metrics.dump());
+}
+
+// The full pipeline on the first 75 frames of two takes: rendered, tracked and read, with the
+// same results for one thread as for two.
+TEST(AnimatorRunTest, FullFidelityTracksReadsAndDoesNotDependOnThreads) {
+  const RunConfig config = ShortConfig(Fidelity::kFull, 75);
+  std::vector<std::pair<int, int>> done;
+  const AnimatorRun run = RunAnimator(
+      config, 1, {}, [&](const TakeRun& t, bool practice) { done.emplace_back(t.take, practice); });
+  EXPECT_EQ(done, (std::vector<std::pair<int, int>>{{0, 0}, {1, 0}}));
+  EXPECT_EQ(run.rendered_frames, 2 * 2 * 75);
+  for (const nlohmann::json& t : run.metrics["takes"]) {
+    EXPECT_GE(t["tracking"]["success_rate"].get<double>(), 0.9) << t.dump();
+    EXPECT_LT(t["tracking"]["rotation_deg"]["median"].get<double>(), 3.0);
+    EXPECT_LT(t["tracking"]["translation_m"]["median"].get<double>(), 0.004);
+    EXPECT_LT(t["tracking"]["table_frame_rotation_deg"].get<double>(), 1.0);
+    EXPECT_LT(t["annotation"]["rmse"].get<double>(), 0.3);
+    EXPECT_GT(t["annotation"]["found_share"].get<double>(), 0.95);
+  }
+  EXPECT_EQ(run.montage.summary.reference_frames, 75);
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    EXPECT_EQ(RunAnimator(config, 1).metrics.dump(), run.metrics.dump());
+  }
+}
+
+TEST(AnimatorRunTest, ATakeWhoseTrackingFailedIsNamedAndTheFinishedTakesAreReported) {
+  Config config;
+  config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  config.Set("render.frames=20");
+  config.Set("run.takes=2");
+  // No pose can pass verification: every frame is lost.
+  config.Set("tracker.verification.max_rms=1e-9");
+  const RunConfig run_config = RunConfig::FromConfig(config);
+  int reported = 0;
+  try {
+    RunAnimator(run_config, 0, {}, [&](const TakeRun&, bool) { ++reported; });
+    FAIL() << "no RunError";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("take 0: tracking failed"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("run.min_tracked_share"), std::string::npos);
+  }
+  EXPECT_EQ(reported, 2);
+}
+
+TEST(AnimatorRunTest, BadInputIsNamed) {
+  Config config;
+  config.Set("render.story=\"no/such/story.json\"");
+  EXPECT_NE(
+      ErrorOf([&] { RunAnimator(RunConfig::FromConfig(config), 0); }).find("no/such/story.json"),
+      std::string::npos);
+  Config no_story;
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(no_story); }).find("render.story"),
+            std::string::npos);
+  Config one_take;
+  one_take.Set("render.story=\"configs/stories/soldier.json\"");
+  one_take.Set("run.takes=1");
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(one_take); }).find("run.takes"), std::string::npos);
+  Config unknown;
+  unknown.Set("render.story=\"configs/stories/soldier.json\"");
+  unknown.Set("run.take=2");
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(unknown); }).find("run.take"), std::string::npos);
+  Config section;
+  section.Set("render.story=\"configs/stories/soldier.json\"");
+  section.Set("tracking.x=2");
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(section); }).find("tracking"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mmh::pipeline
