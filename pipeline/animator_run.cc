@@ -207,6 +207,15 @@ RunConfig RunConfig::FromConfig(const Config& config,
   if (c.render.render.story.empty()) {
     ThrowBadValue("render.story", "\"\"", "a story file (e.g. configs/stories/soldier.json)");
   }
+  // The stories are read now, so that a missing or broken one stops the run before any output.
+  const sim::Story story = sim::LoadStory(c.render.render.story, c.render.scene);
+  if (c.render.render.object < 0 ||
+      c.render.render.object >= static_cast<int>(story.objects.size())) {
+    ThrowBadValue("render.object", std::to_string(c.render.render.object),
+                  "an object of " + c.render.render.story + " (0.." +
+                      std::to_string(story.objects.size() - 1) + ")");
+  }
+  if (!c.run.practice.empty()) sim::LoadStory(c.run.practice, c.render.scene);
   if (std::abs(c.render.performance.frame_rate - c.render.sensor.frame_rate) > 1e-9) {
     ThrowBadValue("performance.frame_rate", FormatNumber(c.render.performance.frame_rate),
                   "the sensor's frame rate (sensor.frame_rate = " +

@@ -112,17 +112,22 @@ TEST(AnimatorRunTest, BadInputIsNamed) {
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(no_story); }).find("render.story"),
             std::string::npos);
   Config one_take;
-  one_take.Set("render.story=\"configs/stories/soldier.json\"");
+  one_take.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   one_take.Set("run.takes=1");
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(one_take); }).find("run.takes"), std::string::npos);
   Config unknown;
-  unknown.Set("render.story=\"configs/stories/soldier.json\"");
+  unknown.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   unknown.Set("run.take=2");
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(unknown); }).find("run.take"), std::string::npos);
   Config section;
-  section.Set("render.story=\"configs/stories/soldier.json\"");
+  section.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   section.Set("tracking.x=2");
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(section); }).find("tracking"), std::string::npos);
+  Config object;
+  object.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  object.Set("render.object=1");
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(object); }).find("render.object"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,110 @@
+// `mmh run` and `mmh regress` through the binary.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/test_util.h"
+
+namespace mmh {
+namespace {
+
+using test_util::ReadBytes;
+using test_util::RunMmh;
+using test_util::TempDir;
+using test_util::WriteText;
+
+const std::string kSource = MMH_SOURCE_DIR;
+const std::string kStory = "--set 'render.story=\"" + kSource + "/configs/stories/soldier.json\"' ";
+
+// Two 70-frame takes of the Soldier, rendered, tracked, read and composited.
+std::string ShortRun(const std::filesystem::path& out, const std::string& extra = "") {
+  return "run --config " + kSource + "/configs/soldier.json " + kStory +
+         "--set render.frames=70 --set run.takes=2 --quiet --out " + out.string() + " " + extra;
+}
+
+TEST(RunCliTest, WritesEveryResultAndTheSameBytesForAnyThreadCount) {
+  TempDir dir;
+  const auto one = RunMmh(ShortRun(dir / "one", "--threads 1"));
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  EXPECT_EQ(one.output, "");  // --quiet
+  const auto two = RunMmh(ShortRun(dir / "two", "--threads 2"));
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  for (const char* file :
+       {"metrics.json", "metrics.csv", "tracking_frames.csv", "seams.csv", "config.resolved.json",
+        "takes/take_0/truth.tum", "takes/take_0/tracked.tum", "takes/take_0/status.csv",
+        "takes/take_0/truth_annotation.csv", "takes/take_1/read_annotation.csv",
+        "takes/take_1/quality.csv", "montage/montage.tum", "montage/segments.csv",
+        "montage/summary.json", "montage_truth/montage.tum"}) {
+    ASSERT_TRUE(std::filesystem::exists(dir / "one" / file)) << file;
+    EXPECT_EQ(ReadBytes(dir / "one" / file), ReadBytes(dir / "two" / file)) << file;
+  }
+  const nlohmann::json run = nlohmann::json::parse(ReadBytes(dir / "one/run.json"));
+  EXPECT_EQ(run["seconds"]["rendered_frames"], 280);
+  EXPECT_GT(run["seconds"]["render_track_frames_per_second"].get<double>(), 0.0);
+  EXPECT_NE(ReadBytes(dir / "one/metrics.csv").find("takes,0,tracking.rotation_deg.median,"),
+            std::string::npos);
+}
+
+TEST(RunCliTest, BadInputExitsTwoAndWritesNothing) {
+  TempDir dir;
+  auto r = RunMmh("run --config " + kSource +
+                  "/configs/soldier.json --set 'render.story=\"nowhere/story.json\"' --out " +
+                  (dir / "a").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("nowhere/story.json"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "a"));
+  r = RunMmh(ShortRun(dir / "b", "--set run.fidelity=approximate"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("run.fidelity"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+}
+
+// Every frame lost: the run fails (exit 1) naming the take, and keeps what the sessions produced.
+TEST(RunCliTest, FailedTrackingKeepsTheFinishedStages) {
+  TempDir dir;
+  const auto r = RunMmh("run --config " + kSource + "/configs/soldier.json " + kStory +
+                        "--set render.frames=20 --set run.takes=2 "
+                        "--set tracker.verification.max_rms=1e-9 --quiet --out " +
+                        (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("take 0: tracking failed"), std::string::npos) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/takes/take_0/status.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/takes/take_1/read_annotation.csv"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "out/config.resolved.json"));
+  EXPECT_NE(ReadBytes(dir / "out/run.json").find("\"failed\": true"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/metrics.json"));
+}
+
+// A baseline made by --update passes; a baseline value moved beyond its tolerance fails (exit 1)
+// and the table names the metric.
+TEST(RunCliTest, RegressPassesItsOwnBaselineAndCatchesAChange) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "baseline");
+  WriteText(dir / "baseline/baseline.json",
+            R"({"root": ")" + kSource + R"(", "scenarios": [{"name": "quick",
+               "config": "configs/soldier.json", "set": ["run.fidelity=fast", "render.frames=300",
+               "render.story=\"configs/stories/soldier.json\""], "metrics": {}}]})");
+  auto r = RunMmh("regress --baseline " + (dir / "baseline").string() + " --update --quiet --out " +
+                  (dir / "update").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  nlohmann::json baseline = nlohmann::json::parse(ReadBytes(dir / "baseline/baseline.json"));
+  ASSERT_GT(baseline["scenarios"][0]["metrics"].size(), 20u);
+  r = RunMmh("regress --baseline " + (dir / "baseline").string() + " --out " +
+             (dir / "same").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("0 regressed"), std::string::npos) << r.output;
+  baseline["scenarios"][0]["metrics"]["montage.truth.total_cost"]["value"] =
+      baseline["scenarios"][0]["metrics"]["montage.truth.total_cost"]["value"].get<double>() * 1.01;
+  WriteText(dir / "baseline/baseline.json", baseline.dump(2));
+  r = RunMmh("regress --baseline " + (dir / "baseline").string() + " --out " +
+             (dir / "moved").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("montage.truth.total_cost"), std::string::npos);
+  EXPECT_NE(r.output.find("REGRESSED"), std::string::npos);
+  EXPECT_NE(ReadBytes(dir / "moved/regress.csv").find("REGRESSED"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mmh
