@@ -43,8 +43,13 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                                                     args.common.threads);
   }
 
-  // Everything is read and checked before the first frame.
-  const TriangleMesh model = LoadMesh(args.model, track_config.run.model_scale);
+  // Everything is read and checked before the first frame. Slider-only mode (run.proxy false,
+  // annotation sessions) needs no model; one given is still read and checked.
+  if (args.model.empty() && track_config.run.proxy) {
+    throw InputError("--model is required (the proxy's mesh) unless --set run.proxy=false");
+  }
+  const TriangleMesh model =
+      args.model.empty() ? TriangleMesh() : LoadMesh(args.model, track_config.run.model_scale);
   const bool live = args.input == "freenect";
   if (!live && !fs::is_directory(args.input)) {
     ThrowBadValue("--input", "\"" + args.input + "\"",
@@ -95,9 +100,13 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   written.push_back("run.json");
   if (!args.common.quiet) {
     const track::TrackSummary& s = run.summary;
-    std::cout << "track: " << s.frames << " frames from " << source->Describe() << ": " << s.tracked
-              << " tracked, " << s.predicted << " predicted, " << s.lost << " lost ("
-              << s.detections << " detections)";
+    std::cout << "track: " << s.frames << " frames from " << source->Describe() << ": ";
+    if (track_config.run.proxy) {
+      std::cout << s.tracked << " tracked, " << s.predicted << " predicted, " << s.lost << " lost ("
+                << s.detections << " detections)";
+    } else {
+      std::cout << "proxy not tracked (run.proxy=false)";
+    }
     if (!run.slider.empty()) std::cout << "; slider found in " << s.slider_found;
     std::cout << "; " << (s.seconds > 0 ? s.frames / s.seconds : 0.0) << " frames/s\n";
     if (!calibrated) {
@@ -110,6 +119,13 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   }
   if (run.summary.frames == 0) {
     throw InputError("--input " + args.input + ": the source delivered no frame");
+  }
+  if (!track_config.run.proxy) {
+    if (run.summary.slider_found == 0) {
+      throw std::runtime_error("the slider block was found in no frame; see " +
+                               (out / "status.csv").string());
+    }
+    return;
   }
   if (run.summary.tracked == 0) {
     // A failure of the work, not of the input's form: every frame was lost (status.csv says why).
@@ -130,9 +146,8 @@ void AddTrackCommand(CLI::App& app, const std::vector<std::string>& argv) {
                   "A TUM RGB-D folder (ours or a public sequence), or 'freenect' for a Kinect v1")
       ->required();
   cmd->add_option("--model", args->model,
-                  "The proxy's mesh (.ply or .obj), e.g. model.ply of a "
-                  "rendered take")
-      ->required();
+                  "The proxy's mesh (.ply or .obj), e.g. model.ply of a rendered take; "
+                  "required unless --set run.proxy=false (slider only)");
   cmd->add_option("--setup", args->setup,
                   "Setup calibration (scene.json keys: camera_T_table, table.play_area_*, "
                   "table.like_box_*); default: INPUT/scene.json when present");

@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/tum_io.h"
+#include "track/table_plane.h"
 
 namespace mmh::track {
 
@@ -47,11 +48,83 @@ nlohmann::json TrackSummary::ToJson() const {
           {"seconds", seconds},       {"frames_per_second", seconds > 0 ? frames / seconds : 0.0}};
 }
 
+namespace {
+
+// Slider-only mode (TrackRunOptions::proxy false): the table frame from one RANSAC plane, found on
+// the first frame that has one and retried every kPlaneRetryFrames frames until then (a plane per
+// frame would cost more than the slider reading itself).
+class SliderOnlyTable {
+ public:
+  SliderOnlyTable(const TablePlaneOptions& options, const std::optional<Rigid3>& calibration)
+      : options_(options), calibration_(calibration) {}
+
+  // The table frame for `frame` (a readable frame), or nullopt with the reason.
+  const std::optional<Rigid3>& Update(const RgbdFrame& frame, std::string* why) {
+    if (camera_T_table_) return camera_T_table_;
+    if (attempted_ && frame.index - last_attempt_ < kPlaneRetryFrames) {
+      *why = "no table plane yet (" + last_why_ + ")";
+      return camera_T_table_;
+    }
+    attempted_ = true;
+    last_attempt_ = frame.index;
+    try {
+      frame.depth_intrinsics.Validate("frame intrinsics");
+      plane_ = EstimateTablePlane(frame, options_, calibration_, &last_why_);
+    } catch (const InputError& e) {
+      last_why_ = e.what();
+    }
+    if (plane_) {
+      camera_T_table_ = TableFrameOnPlane(*plane_, calibration_);
+      intrinsics_ = frame.depth_intrinsics;
+    } else {
+      *why = "no table plane yet (" + last_why_ + ")";
+    }
+    return camera_T_table_;
+  }
+  // Frames of other intrinsics than the plane's frame are not read (the same check as the
+  // tracker's).
+  bool SameCamera(const RgbdFrame& frame) const { return frame.depth_intrinsics == intrinsics_; }
+  const std::optional<TablePlane>& plane() const { return plane_; }
+  const std::optional<Rigid3>& camera_T_table() const { return camera_T_table_; }
+
+ private:
+  static constexpr int kPlaneRetryFrames = 15;
+  TablePlaneOptions options_;
+  std::optional<Rigid3> calibration_;
+  std::optional<TablePlane> plane_;
+  std::optional<Rigid3> camera_T_table_;
+  PinholeIntrinsics intrinsics_;
+  bool attempted_ = false;
+  int last_attempt_ = 0;
+  std::string last_why_;
+};
+
+}  // namespace
+
 TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::string& model_name,
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
                      const std::function<void(int, int)>& progress) {
   config.run.Validate("run");
-  ProxyTracker tracker(model, model_name, setup, config.tracker);
+  const bool slider_only = !config.run.proxy;
+  if (slider_only) {
+    if (!config.run.slider) {
+      ThrowBadValue("run.slider", "false", "true when run.proxy is false (nothing would be read)");
+    }
+    if (!setup_calibrated || !setup.has_like_box()) {
+      throw InputError(
+          "run.proxy = false (slider-only mode) reads only the slider, which needs a setup "
+          "calibration with a Like box (--setup FILE or INPUT/scene.json, table.like_box_length "
+          "> 0); " +
+          std::string(setup_calibrated ? "the setup's like_box_length is 0"
+                                       : "no setup calibration was given"));
+    }
+    config.tracker.table.Validate("tracker.table");
+    setup.Validate("setup");
+  }
+  // Slider-only mode builds no proxy model (the model may be empty).
+  std::optional<ProxyTracker> tracker;
+  if (!slider_only) tracker.emplace(model, model_name, setup, config.tracker);
+  SliderOnlyTable slider_table(config.tracker.table, setup.camera_T_table);
   std::optional<SliderReader> slider;
   if (config.run.slider && setup_calibrated && setup.has_like_box()) {
     slider.emplace(setup, config.slider);
@@ -63,16 +136,32 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
   while ((config.run.max_frames == 0 || run.summary.frames < config.run.max_frames) &&
          source.Next(&frame)) {
     const auto start = Clock::now();
-    const TrackFrameResult result = source.frame_error().empty()
-                                        ? tracker.Track(frame)
-                                        : tracker.Unreadable(frame, source.frame_error());
+    const bool readable = source.frame_error().empty();
+    TrackFrameResult result;
+    std::string no_table = "no table plane yet";
+    const std::optional<Rigid3>* camera_T_table = nullptr;
+    if (tracker) {
+      result = readable ? tracker->Track(frame) : tracker->Unreadable(frame, source.frame_error());
+      camera_T_table = &tracker->camera_T_table();
+    } else {
+      result.index = frame.index;
+      result.timestamp = frame.timestamp;
+      result.reason = readable ? "proxy not tracked" : "unreadable frame: " + source.frame_error();
+      if (readable) {
+        camera_T_table = &slider_table.Update(frame, &no_table);
+        if (*camera_T_table && !slider_table.SameCamera(frame)) {
+          camera_T_table = nullptr;
+          no_table = "frame size or intrinsics differ from the table plane's frame";
+        }
+      }
+    }
     run.frames.push_back(result);
     if (slider) {
       SliderReading reading;
-      if (tracker.camera_T_table() && source.frame_error().empty()) {
-        reading = slider->Read(frame, *tracker.camera_T_table());
+      if (readable && camera_T_table && *camera_T_table) {
+        reading = slider->Read(frame, **camera_T_table);
       } else {
-        reading.reason = source.frame_error().empty() ? "no table plane yet" : "unreadable frame";
+        reading.reason = readable ? no_table : "unreadable frame";
       }
       if (reading.found) last_value = reading.value;
       run.summary.slider_found += reading.found;
@@ -88,16 +177,21 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
     run.summary.detections += result.detected;
     if (result.status != TrackStatus::kLost) {
       Rigid3 pose = result.camera_T_proxy;
-      if (config.run.output_frame == OutputFrame::kTable && tracker.camera_T_table()) {
-        pose = tracker.camera_T_table()->Inverse() * pose;
+      if (config.run.output_frame == OutputFrame::kTable && tracker->camera_T_table()) {
+        pose = tracker->camera_T_table()->Inverse() * pose;
       }
       run.trajectory.timestamps.push_back(frame.timestamp);
       run.trajectory.poses.push_back(pose);
     }
     if (progress) progress(run.summary.frames, source.size());
   }
-  run.camera_T_table = tracker.camera_T_table();
-  run.table_plane = tracker.table_plane();
+  if (tracker) {
+    run.camera_T_table = tracker->camera_T_table();
+    run.table_plane = tracker->table_plane();
+  } else {
+    run.camera_T_table = slider_table.camera_T_table();
+    run.table_plane = slider_table.plane();
+  }
   return run;
 }
 

@@ -35,6 +35,14 @@ struct TrackRunOptions {
   double model_scale = 1.0;
   // Read the slider (needs a setup calibration with a Like box).
   bool slider = true;
+  // Track the proxy. false: slider-only mode for annotation sessions (the proxy rests outside the
+  // play area and the hand moves the slider block): no proxy model is built and no detection runs;
+  // the table plane is estimated once (RANSAC on the first frame with a plane, retried every
+  // 15 frames until found) and the slider is read on every frame. Every frame's TrackFrameResult
+  // is then lost with the reason "proxy not tracked" (frames stays one per frame, for status.csv),
+  // the trajectory is empty. Needs slider reading and a setup calibration with a Like box
+  // (InputError otherwise).
+  bool proxy = true;
   // Intrinsics for a TUM-layout folder without camera.json and without 'freiburg1/2/3' in its
   // name (used only when override_intrinsics is true, then for any folder).
   bool override_intrinsics = false;
@@ -47,6 +55,7 @@ struct TrackRunOptions {
     v("output_frame", output_frame);
     v("model_scale", model_scale);
     v("slider", slider);
+    v("proxy", proxy);
     v("override_intrinsics", override_intrinsics);
     v("intrinsics", intrinsics);
     v("max_frames", max_frames);
@@ -92,6 +101,8 @@ struct TrackRun {
 // Tracks every frame of `source` (progress(done, total or -1) after each). The setup is the
 // calibration (track/setup.h); slider reading needs one with a Like box and setup_calibrated
 // (without a calibration the table frame is the estimated one, where the Like box is unknown).
+// With config.run.proxy false (slider-only mode) `model` is not used (it may be empty), and a
+// missing calibration or Like box, or run.slider false, is an InputError before the first frame.
 TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::string& model_name,
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
                      const std::function<void(int, int)>& progress = {});

@@ -7,8 +7,11 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "metrics/tracking_metrics.h"
@@ -22,13 +25,13 @@ struct TakeResult {
   std::vector<TrackFrameResult> frames;
 };
 
-TakeResult TrackTake(test_take::SimTake& take, int frames,
-                     const ProxyTrackerOptions& options = {}) {
+TakeResult TrackTake(test_take::SimTake& take, int frames, const ProxyTrackerOptions& options = {},
+                     int first = 0) {
   ProxyTracker tracker(take.model(), "soldier", take.Setup(), options);
   std::vector<std::optional<Rigid3>> estimates;
   std::vector<Rigid3> truth;
   TakeResult result;
-  for (int i = 0; i < frames; ++i) {
+  for (int i = first; i < first + frames; ++i) {
     Rigid3 camera_T_proxy;
     const RgbdFrame frame = take.Render(i, &camera_T_proxy);
     const TrackFrameResult r = tracker.Track(frame);
@@ -49,7 +52,7 @@ TakeResult TrackTake(test_take::SimTake& take, int frames,
     if (!errors[i].success) {
       std::printf(
           "frame %zu %s rot %.2f trans %.4f pts %d skin %d share %.2f rms %.4f fs %.2f det %d %s\n",
-          i, TrackStatusName(result.frames[i].status), errors[i].rotation_deg,
+          i + first, TrackStatusName(result.frames[i].status), errors[i].rotation_deg,
           errors[i].translation, result.frames[i].points, result.frames[i].skin_points,
           result.frames[i].inlier_share, result.frames[i].rms,
           result.frames[i].free_space_violation, result.frames[i].detected,
@@ -146,6 +149,23 @@ TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
   int detections = 0;
   for (const auto& frame : result.frames) detections += frame.detected;
   EXPECT_GE(detections, 4);  // the first frame and each jump
+}
+
+// Survey (not part of the suite): MMH_SURVEY="animator:take:first:frames ..." tracks those
+// stretches of Soldier story recordings and prints every failed frame.
+TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
+  const char* spec = std::getenv("MMH_SURVEY");
+  std::istringstream in(spec ? spec : "3:1:0:300");
+  for (std::string item; in >> item;) {
+    int animator = 0, take_index = 0, first = 0, frames = 0, take_frames = 0;
+    std::sscanf(item.c_str(), "%d:%d:%d:%d", &animator, &take_index, &first, &frames);
+    test_take::SimTake take = test_take::SoldierStorySession(
+        MMH_SOURCE_DIR, animator, take_index, sim::RenderSession::kRecording, &take_frames);
+    frames = std::min(frames, take_frames - first);
+    std::printf("== animator %d take %d frames %d..%d of %d\n", animator, take_index, first,
+                first + frames, take_frames);
+    TrackTake(take, frames, {}, first);
+  }
 }
 
 }  // namespace

@@ -3,15 +3,23 @@
 // ground truth beside each frame. Only tests and benchmarks use sim/; track/ never does.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <memory>
+#include <string>
 #include <utility>
+#include <vector>
 
+#include "core/config.h"
 #include "core/rgbd_frame.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 #include "sim/kinect_sensor.h"
+#include "sim/performance.h"
+#include "sim/population.h"
 #include "sim/render_session.h"
+#include "sim/story.h"
 #include "track/setup.h"
 
 namespace mmh::track::test_take {
@@ -73,5 +81,48 @@ class SimTake {
   std::unique_ptr<sim::KinectSensor> sensor_;
   Rigid3 depth_T_table_;
 };
+
+// A session of the Soldier story (configs/study_soldier.json: the castle props, the study's
+// population) as `mmh render --config configs/study_soldier.json --set render.animator=A
+// --set render.take=K --set render.session=...` renders it: participant `animator` performs take
+// `take` of the Soldier (sim::PerformTake); a recording session moves the proxy along the performed
+// take with the hand on it, an annotation session rests the proxy beside the play area and moves
+// the slider block as the participant annotates the take. *frames: the take's length.
+// `source` is the project's folder (MMH_SOURCE_DIR).
+inline SimTake SoldierStorySession(const std::string& source, int animator, int take,
+                                   sim::RenderSession session, int* frames) {
+  sim::RenderConfig config =
+      sim::RenderConfig::FromConfig(Config::Load(source + "/configs/study_soldier.json"));
+  config.render.story = source + "/configs/stories/soldier.json";
+  config.render.animator = animator;
+  config.render.take = take;
+  config.render.session = session;
+  const sim::Story story = sim::LoadStory(config.render.story, config.scene);
+  const sim::Participant participant = sim::DrawParticipant(config.population, animator);
+  auto performed = std::make_shared<const sim::PerformedTake>(
+      sim::PerformTake(story, 0, participant.animator, take, config.performance,
+                       sim::ParticipantSeed(config.population, animator)));
+  config.render.proxy = sim::StoryProxyFile(config.render.story, story, 0);
+  *frames = performed->frames();
+  const double rate = config.sensor.frame_rate;
+  const int last = *frames - 1;
+  auto frame_at = [rate, last](double t) {
+    return std::clamp(static_cast<int>(std::lround(t * rate)), 0, last);
+  };
+  if (session == sim::RenderSession::kRecording) {
+    const double rest = config.annotator.start_value;
+    return SimTake(
+        config,
+        [performed, frame_at](double t) { return performed->table_T_proxy.poses[frame_at(t)]; },
+        [rest](double) { return rest; });
+  }
+  auto slider = std::make_shared<const std::vector<double>>(
+      sim::AnnotateStoryTake(config, participant, *performed).slider);
+  SimTake annotation(
+      config, [](double) { return sim::RestingTableTProxy(); },
+      [slider, frame_at](double t) { return (*slider)[frame_at(t)]; });
+  annotation.set_hand(sim::TableTopScene::Hand::kOnSlider);
+  return annotation;
+}
 
 }  // namespace mmh::track::test_take

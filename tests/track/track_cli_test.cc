@@ -89,6 +89,50 @@ TEST(TrackCliTest, TracksARenderedTakeFromItsFolder) {
   }
 }
 
+// An annotation session (the proxy rests outside the play area, the hand moves the slider block):
+// the default mode tracks no proxy (exit 1); slider-only mode (run.proxy=false, no model needed)
+// exits 0 with annotation.csv within 0.3 RMSE of the rendered block's values and no trajectory.
+TEST(TrackCliTest, SliderOnlyModeOnAnAnnotationSession) {
+  TempDir dir;
+  const fs::path take = dir / "annotation";
+  const std::string source = MMH_SOURCE_DIR;
+  auto render = RunMmh("render --quiet --config " + source +
+                       "/configs/study_soldier.json --set render.story=\\\"" + source +
+                       "/configs/stories/soldier.json\\\" --set render.animator=3 --set "
+                       "render.take=1 --set render.session=annotation --set render.frames=30 "
+                       "--out " +
+                       take.string());
+  ASSERT_EQ(render.exit_code, 0) << render.output;
+  const std::string input = "track --input " + take.string() + " --out ";
+  auto tracked = RunMmh(input + (dir / "proxy").string() + " --model " +
+                        (take / "model.ply").string() + " --set run.max_frames=5");
+  EXPECT_EQ(tracked.exit_code, 1) << tracked.output;
+  auto slider = RunMmh(input + (dir / "slider").string() + " --set run.proxy=false");
+  ASSERT_EQ(slider.exit_code, 0) << slider.output;
+  EXPECT_THAT(slider.output, HasSubstr("proxy not tracked (run.proxy=false); slider found in 30"));
+  EXPECT_FALSE(fs::exists(dir / "slider" / "trajectory.tum"));
+  const Annotation read = ReadAnnotationCsv(dir / "slider" / "annotation.csv");
+  const Annotation truth = ReadAnnotationCsv(take / "slider.csv");
+  ASSERT_EQ(read.size(), truth.size());
+  double sum = 0.0;
+  for (size_t i = 0; i < read.size(); ++i) sum += std::pow(read.values[i] - truth.values[i], 2);
+  EXPECT_LE(std::sqrt(sum / read.size()), 0.3);
+  const auto status = Lines(ReadBytes(dir / "slider" / "status.csv"));
+  ASSERT_EQ(status.size(), 31u);
+  EXPECT_THAT(status[1], HasSubstr(",lost,0,0,0,0,0,0,1,"));
+  EXPECT_THAT(status[1], HasSubstr("proxy not tracked"));
+  // Without the setup calibration (no Like box to read): a clear error, nothing written.
+  fs::remove(take / "scene.json");
+  auto no_setup = RunMmh(input + (dir / "none").string() + " --set run.proxy=false");
+  EXPECT_EQ(no_setup.exit_code, 2) << no_setup.output;
+  EXPECT_THAT(no_setup.output, HasSubstr("needs a setup calibration with a Like box"));
+  EXPECT_FALSE(fs::exists(dir / "none" / "status.csv"));
+  // The proxy mode still needs the model.
+  auto no_model = RunMmh(input + (dir / "none").string());
+  EXPECT_EQ(no_model.exit_code, 2) << no_model.output;
+  EXPECT_THAT(no_model.output, HasSubstr("--model is required"));
+}
+
 TEST(TrackCliTest, TableFrameOutput) {
   const fs::path take = RenderedTake();
   TempDir dir;
