@@ -1,0 +1,354 @@
+#include "pipeline/error_model.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/options.h"
+#include "sim/random.h"
+
+namespace mmh::pipeline {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Random streams of one simulated take, so that changing one part of the model leaves the draws
+// of the others alone.
+enum Stream : std::uint64_t { kPoseStream = 1, kGrossStream, kLossStream, kSliderStream };
+
+void RequireCorrelation(double value, const std::string& where) {
+  RequireFinite(value, where);
+  if (value < 0.0 || value >= 1.0) ThrowBadValue(where, FormatNumber(value), "a value in [0, 1)");
+}
+
+void RequireEpisodeLength(double value, const std::string& where) {
+  RequireFinite(value, where);
+  if (value < 1.0) ThrowBadValue(where, FormatNumber(value), "a mean length of at least 1 frame");
+}
+
+// A stationary AR(1) process with standard deviation `sd` and lag-one correlation `rho`.
+class Ar1 {
+ public:
+  Ar1(double sd, double rho) : sd_(sd), rho_(rho), innovation_(std::sqrt(1.0 - rho * rho)) {}
+  double Next(sim::Random& random) {
+    x_ = started_ ? rho_ * x_ + innovation_ * sd_ * random.Normal() : sd_ * random.Normal();
+    started_ = true;
+    return x_;
+  }
+
+ private:
+  double sd_, rho_, innovation_;
+  double x_ = 0.0;
+  bool started_ = false;
+};
+
+// Marks the frames of episodes that start at each free frame with probability `rate` and last a
+// geometric number of frames with mean `mean_frames`. Frames already marked in `busy` neither
+// start nor extend an episode.
+std::vector<bool> DrawEpisodes(int frames, double rate, double mean_frames,
+                               const std::vector<bool>& busy, std::uint64_t seed) {
+  std::vector<bool> in_episode(frames, false);
+  sim::Random random(seed);
+  const double stop = 1.0 / mean_frames;
+  for (int t = 0; t < frames; ++t) {
+    if (busy[t] || !random.Bernoulli(rate)) continue;
+    // Length k >= 1 with P(k) = (1 - stop)^(k - 1) stop.
+    int k = 1;
+    while (!random.Bernoulli(stop)) ++k;
+    for (int u = t; u < std::min(frames, t + k) && !busy[u]; ++u) in_episode[u] = true;
+    t += k - 1;
+  }
+  return in_episode;
+}
+
+// The error of `tracked` against `truth` in the proxy frame: rotation vector and translation.
+std::array<double, 6> PoseError(const Rigid3& truth, const Rigid3& tracked) {
+  Eigen::Quaterniond q = truth.rotation.conjugate() * tracked.rotation;
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  const Eigen::AngleAxisd angle_axis(q.normalized());
+  const Eigen::Vector3d r = angle_axis.angle() * angle_axis.axis();
+  const Eigen::Vector3d e = truth.rotation.conjugate() * (tracked.translation - truth.translation);
+  return {r.x(), r.y(), r.z(), e.x(), e.y(), e.z()};
+}
+
+// Runs of true values: (number of runs, frames in them, frames at risk of starting one = frames
+// not in a run and not excluded).
+struct Runs {
+  int runs = 0;
+  std::int64_t frames = 0;
+  std::int64_t at_risk = 0;
+};
+void CountRuns(const std::vector<bool>& flag, const std::vector<bool>& excluded, Runs* runs) {
+  for (std::size_t t = 0; t < flag.size(); ++t) {
+    if (flag[t]) {
+      ++runs->frames;
+      if (t == 0 || !flag[t - 1]) ++runs->runs;
+    } else if (!excluded[t]) {
+      ++runs->at_risk;
+    }
+  }
+}
+
+}  // namespace
+
+void ErrorModelOptions::Validate(const std::string& prefix) const {
+  RequireNonNegative(translation_sd, prefix + ".translation_sd", "m");
+  RequireNonNegative(rotation_sd, prefix + ".rotation_sd", "rad");
+  RequireCorrelation(correlation, prefix + ".correlation");
+  RequireProbability(gross_rate, prefix + ".gross_rate");
+  RequireEpisodeLength(gross_mean_frames, prefix + ".gross_mean_frames");
+  RequireFinite(gross_rotation, prefix + ".gross_rotation");
+  if (gross_rotation < 0 || gross_rotation > kPi) {
+    ThrowBadValue(prefix + ".gross_rotation", FormatNumber(gross_rotation),
+                  "an angle in [0, pi] rad");
+  }
+  RequireProbability(loss_rate, prefix + ".loss_rate");
+  RequireEpisodeLength(loss_mean_frames, prefix + ".loss_mean_frames");
+  RequireNonNegative(slider_sd, prefix + ".slider_sd", "slider units");
+  RequireCorrelation(slider_correlation, prefix + ".slider_correlation");
+  RequireFinite(slider_bias, prefix + ".slider_bias");
+  if (std::abs(slider_bias) > 10) {
+    ThrowBadValue(prefix + ".slider_bias", FormatNumber(slider_bias),
+                  "a bias within [-10, 10] slider units");
+  }
+  RequireProbability(slider_miss_share, prefix + ".slider_miss_share");
+  if (slider_miss_share >= 1.0) {
+    ThrowBadValue(prefix + ".slider_miss_share", FormatNumber(slider_miss_share),
+                  "a share below 1 (some frames must be found)");
+  }
+}
+
+SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOptions& options,
+                                   std::uint64_t seed) {
+  options.Validate("error_model");
+  const int frames = static_cast<int>(truth.size());
+  SimulatedTracking out;
+  out.tracked.timestamps = truth.timestamps;
+  out.tracked.poses.resize(frames);
+  out.status.assign(frames, track::TrackStatus::kTracked);
+
+  const std::vector<bool> none(frames, false);
+  const std::vector<bool> lost = DrawEpisodes(frames, options.loss_rate, options.loss_mean_frames,
+                                              none, sim::DeriveSeed(seed, {kLossStream}));
+  const std::vector<bool> gross =
+      DrawEpisodes(frames, options.gross_rate, options.gross_mean_frames, lost,
+                   sim::DeriveSeed(seed, {kGrossStream}));
+
+  sim::Random random(sim::DeriveSeed(seed, {kPoseStream}));
+  std::array<Ar1, 6> axes = {Ar1(options.rotation_sd, options.correlation),
+                             Ar1(options.rotation_sd, options.correlation),
+                             Ar1(options.rotation_sd, options.correlation),
+                             Ar1(options.translation_sd, options.correlation),
+                             Ar1(options.translation_sd, options.correlation),
+                             Ar1(options.translation_sd, options.correlation)};
+  const Eigen::Quaterniond twin(
+      Eigen::AngleAxisd(options.gross_rotation, Eigen::Vector3d::UnitZ()));
+  for (int t = 0; t < frames; ++t) {
+    // The error processes run on through losses (the tracker's bias drifts with the view either
+    // way), so the draws of a frame do not depend on the episodes.
+    std::array<double, 6> x;
+    for (int k = 0; k < 6; ++k) x[k] = axes[k].Next(random);
+    if (lost[t]) {
+      out.status[t] = track::TrackStatus::kLost;
+      out.tracked.poses[t] = t > 0 ? out.tracked.poses[t - 1] : truth.poses[t];
+      continue;
+    }
+    const Eigen::Vector3d r(x[0], x[1], x[2]);
+    const double angle = r.norm();
+    const Eigen::Quaterniond proxy_q_error =
+        angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle))
+                  : Eigen::Quaterniond::Identity();
+    const Rigid3 proxy_T_error(proxy_q_error, Eigen::Vector3d(x[3], x[4], x[5]));
+    Rigid3 table_T_tracked = truth.poses[t] * proxy_T_error;
+    if (gross[t]) {
+      // The near-symmetric twin: turned about the table's vertical through the proxy's origin.
+      table_T_tracked.rotation = (twin * table_T_tracked.rotation).normalized();
+    }
+    out.tracked.poses[t] = table_T_tracked;
+  }
+  return out;
+}
+
+SimulatedReading SimulateSliderReading(const Annotation& truth, const ErrorModelOptions& options,
+                                       std::uint64_t seed) {
+  options.Validate("error_model");
+  const int frames = static_cast<int>(truth.size());
+  SimulatedReading out;
+  out.read.timestamps = truth.timestamps;
+  out.read.values.assign(frames, 0.0);
+  out.found.assign(frames, true);
+  sim::Random random(sim::DeriveSeed(seed, {kSliderStream}));
+  Ar1 noise(options.slider_sd, options.slider_correlation);
+  int first_found = -1;
+  for (int t = 0; t < frames; ++t) {
+    const double n = noise.Next(random);
+    out.found[t] = !random.Bernoulli(options.slider_miss_share);
+    if (!out.found[t]) continue;
+    out.read.values[t] =
+        std::clamp(truth.values[t] + options.slider_bias + n, kMinAnnotation, kMaxAnnotation);
+    if (first_found < 0) first_found = t;
+  }
+  // Hold the last found value; before the first found frame, the first found value (or the
+  // truth's first value, clamped, when nothing is found at all).
+  double held =
+      first_found >= 0
+          ? out.read.values[first_found]
+          : (frames > 0 ? std::clamp(truth.values[0], kMinAnnotation, kMaxAnnotation) : 0.0);
+  for (int t = 0; t < frames; ++t) {
+    if (out.found[t]) {
+      held = out.read.values[t];
+    } else {
+      out.read.values[t] = held;
+    }
+  }
+  return out;
+}
+
+nlohmann::json ErrorModelEstimate::ToJson() const {
+  nlohmann::json j = mmh::ToJson(options);
+  return {{"options", j},
+          {"frames", frames},
+          {"inlier_frames", inlier_frames},
+          {"gross_frames", gross_frames},
+          {"lost_frames", lost_frames},
+          {"gross_episodes", gross_episodes},
+          {"loss_episodes", loss_episodes},
+          {"slider_frames", slider_frames},
+          {"slider_missed", slider_missed},
+          {"slider_rmse", slider_rmse}};
+}
+
+ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
+                                      const std::vector<ReadingObservation>& readings,
+                                      const ErrorModelOptions& prior, double gross_threshold_deg,
+                                      double gross_threshold_m) {
+  ErrorModelEstimate estimate;
+  estimate.options = prior;
+  const double gross_threshold_rad = gross_threshold_deg * kPi / 180.0;
+
+  // Pose errors: per type (0 rotation, 1 translation) the sum of squares over inlier frames, and
+  // over consecutive inlier pairs the lag-one products and the mean squares of the pair.
+  std::array<double, 2> squares = {0, 0}, lag_products = {0, 0}, lag_squares = {0, 0};
+  Runs gross_runs, loss_runs;
+  for (std::size_t i = 0; i < tracking.size(); ++i) {
+    const auto& obs = tracking[i];
+    const std::string name = "tracking observation " + std::to_string(i);
+    if (!obs.truth || !obs.tracked || !obs.status) throw InputError(name + ": missing data");
+    const std::size_t n = obs.truth->size();
+    if (obs.tracked->size() != n || obs.status->size() != n) {
+      throw InputError(name + ": truth, tracked and status lengths differ (" + std::to_string(n) +
+                       ", " + std::to_string(obs.tracked->size()) + ", " +
+                       std::to_string(obs.status->size()) + ")");
+    }
+    std::vector<std::array<double, 6>> errors(n);
+    std::vector<bool> lost(n), gross(n), inlier(n);
+    for (std::size_t t = 0; t < n; ++t) {
+      lost[t] = (*obs.status)[t] == track::TrackStatus::kLost;
+      if (lost[t]) continue;
+      errors[t] = PoseError(obs.truth->poses[t], obs.tracked->poses[t]);
+      const double angle = std::hypot(errors[t][0], errors[t][1], errors[t][2]);
+      const double distance = std::hypot(errors[t][3], errors[t][4], errors[t][5]);
+      gross[t] = angle > gross_threshold_rad || distance > gross_threshold_m;
+      inlier[t] = !gross[t];
+      if (!inlier[t]) continue;
+      ++estimate.inlier_frames;
+      for (int k = 0; k < 6; ++k) squares[k / 3] += errors[t][k] * errors[t][k];
+    }
+    for (std::size_t t = 0; t + 1 < n; ++t) {
+      if (!inlier[t] || !inlier[t + 1]) continue;
+      for (int k = 0; k < 6; ++k) {
+        lag_products[k / 3] += errors[t][k] * errors[t + 1][k];
+        lag_squares[k / 3] +=
+            0.5 * (errors[t][k] * errors[t][k] + errors[t + 1][k] * errors[t + 1][k]);
+      }
+    }
+    estimate.frames += static_cast<std::int64_t>(n);
+    CountRuns(lost, std::vector<bool>(n, false), &loss_runs);
+    CountRuns(gross, lost, &gross_runs);
+  }
+  estimate.lost_frames = loss_runs.frames;
+  estimate.gross_frames = gross_runs.frames;
+  estimate.loss_episodes = loss_runs.runs;
+  estimate.gross_episodes = gross_runs.runs;
+  ErrorModelOptions& fit = estimate.options;
+  if (estimate.inlier_frames > 0) {
+    const double axes = 3.0 * static_cast<double>(estimate.inlier_frames);
+    fit.rotation_sd = std::sqrt(squares[0] / axes);
+    fit.translation_sd = std::sqrt(squares[1] / axes);
+  }
+  // Pooled over the six components, each type scaled by its variance.
+  double numerator = 0, denominator = 0;
+  for (int type = 0; type < 2; ++type) {
+    const double sd = type == 0 ? fit.rotation_sd : fit.translation_sd;
+    if (sd <= 0 || lag_squares[type] <= 0) continue;
+    numerator += lag_products[type] / (sd * sd);
+    denominator += lag_squares[type] / (sd * sd);
+  }
+  if (denominator > 0) fit.correlation = std::clamp(numerator / denominator, 0.0, 0.999);
+  if (loss_runs.at_risk > 0) {
+    fit.loss_rate = static_cast<double>(loss_runs.runs) / static_cast<double>(loss_runs.at_risk);
+  }
+  if (loss_runs.runs > 0) {
+    fit.loss_mean_frames = static_cast<double>(loss_runs.frames) / loss_runs.runs;
+  }
+  if (gross_runs.at_risk > 0) {
+    fit.gross_rate = static_cast<double>(gross_runs.runs) / static_cast<double>(gross_runs.at_risk);
+  }
+  if (gross_runs.runs > 0) {
+    fit.gross_mean_frames = static_cast<double>(gross_runs.frames) / gross_runs.runs;
+  }
+
+  // Slider readings over found frames.
+  double sum = 0, sum_squares = 0, slider_lag_product = 0, slider_lag_squares = 0;
+  std::int64_t found_frames = 0;
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    const auto& obs = readings[i];
+    const std::string name = "reading observation " + std::to_string(i);
+    if (!obs.truth || !obs.read || !obs.found) throw InputError(name + ": missing data");
+    const std::size_t n = obs.truth->size();
+    if (obs.read->size() != n || obs.found->size() != n) {
+      throw InputError(name + ": truth, read and found lengths differ (" + std::to_string(n) +
+                       ", " + std::to_string(obs.read->size()) + ", " +
+                       std::to_string(obs.found->size()) + ")");
+    }
+    estimate.slider_frames += static_cast<std::int64_t>(n);
+    for (std::size_t t = 0; t < n; ++t) {
+      if (!(*obs.found)[t]) {
+        ++estimate.slider_missed;
+        continue;
+      }
+      const double e = obs.read->values[t] - obs.truth->values[t];
+      sum += e;
+      sum_squares += e * e;
+      ++found_frames;
+    }
+  }
+  if (found_frames > 1) {
+    const double count = static_cast<double>(found_frames);
+    const double bias = sum / count;
+    fit.slider_bias = bias;
+    fit.slider_sd = std::sqrt(std::max(0.0, (sum_squares - count * bias * bias) / (count - 1)));
+    estimate.slider_rmse = std::sqrt(sum_squares / count);
+    for (const auto& obs : readings) {
+      const std::size_t n = obs.truth->size();
+      for (std::size_t t = 0; t + 1 < n; ++t) {
+        if (!(*obs.found)[t] || !(*obs.found)[t + 1]) continue;
+        const double a = obs.read->values[t] - obs.truth->values[t] - bias;
+        const double b = obs.read->values[t + 1] - obs.truth->values[t + 1] - bias;
+        slider_lag_product += a * b;
+        slider_lag_squares += 0.5 * (a * a + b * b);
+      }
+    }
+    if (slider_lag_squares > 0) {
+      fit.slider_correlation = std::clamp(slider_lag_product / slider_lag_squares, 0.0, 0.999);
+    }
+  }
+  if (estimate.slider_frames > 0) {
+    fit.slider_miss_share =
+        static_cast<double>(estimate.slider_missed) / static_cast<double>(estimate.slider_frames);
+  }
+  return estimate;
+}
+
+}  // namespace mmh::pipeline

@@ -1,0 +1,271 @@
+// The fast-fidelity error model: the statistics of its simulated errors match its options within
+// sampling-theory tolerances (4 standard errors), the estimator recovers the options, and the
+// draws are deterministic per seed.
+#include "pipeline/error_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace mmh::pipeline {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A slow circular walk with turning, #frames at 30 fps.
+Trajectory Walk(int frames) {
+  Trajectory walk;
+  for (int t = 0; t < frames; ++t) {
+    const double s = t / 30.0;
+    walk.timestamps.push_back(s);
+    const double heading = 0.3 * s;
+    walk.poses.emplace_back(
+        Eigen::Quaterniond(Eigen::AngleAxisd(heading, Eigen::Vector3d::UnitZ())) *
+            Eigen::Quaterniond(Eigen::AngleAxisd(0.2 * std::sin(s), Eigen::Vector3d::UnitX())),
+        Eigen::Vector3d(0.1 * std::cos(heading), 0.1 * std::sin(heading), 0.05));
+  }
+  return walk;
+}
+
+// The error components in the proxy frame, computed directly (independent of the estimator).
+std::array<double, 6> Error(const Rigid3& truth, const Rigid3& tracked) {
+  Eigen::Quaterniond q = truth.rotation.conjugate() * tracked.rotation;
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  // Small angles: the rotation vector is 2·(x, y, z) of the quaternion to third order.
+  const Eigen::AngleAxisd aa(q);
+  const Eigen::Vector3d r = aa.angle() * aa.axis();
+  const Eigen::Vector3d e = truth.rotation.conjugate() * (tracked.translation - truth.translation);
+  return {r.x(), r.y(), r.z(), e.x(), e.y(), e.z()};
+}
+
+// Relative standard error of a sample SD from n values of a stationary AR(1) with lag-one
+// correlation rho: Var(s²)/σ⁴ ≈ 2(1 + ρ²)/((1 − ρ²) n), and s has half that relative error.
+double SdRelativeError(double n, double rho) {
+  return 0.5 * std::sqrt(2 * (1 + rho * rho) / ((1 - rho * rho) * n));
+}
+
+TEST(ErrorModelTest, PoseErrorsHaveTheModelsSdAndCorrelation) {
+  ErrorModelOptions options;
+  options.translation_sd = 0.002;
+  options.rotation_sd = 0.01;
+  options.correlation = 0.8;
+  options.loss_rate = 0;
+  options.gross_rate = 0;
+  const int frames = 40000;
+  const Trajectory truth = Walk(frames);
+  const SimulatedTracking sim = SimulateTracking(truth, options, 7);
+  ASSERT_EQ(sim.tracked.size(), truth.size());
+  double sq_r = 0, sq_t = 0, lag = 0, lag_sq = 0;
+  std::array<double, 6> previous{};
+  for (int t = 0; t < frames; ++t) {
+    EXPECT_EQ(sim.status[t], track::TrackStatus::kTracked);
+    const auto e = Error(truth.poses[t], sim.tracked.poses[t]);
+    for (int k = 0; k < 3; ++k) sq_r += e[k] * e[k];
+    for (int k = 3; k < 6; ++k) sq_t += e[k] * e[k];
+    if (t > 0) {
+      for (int k = 0; k < 6; ++k) {
+        const double sd = k < 3 ? options.rotation_sd : options.translation_sd;
+        lag += e[k] * previous[k] / (sd * sd);
+        lag_sq += e[k] * e[k] / (sd * sd);
+      }
+    }
+    previous = e;
+  }
+  const double n = 3.0 * frames;
+  const double tolerance = 4 * SdRelativeError(n, options.correlation);
+  EXPECT_NEAR(std::sqrt(sq_r / n), options.rotation_sd, tolerance * options.rotation_sd);
+  EXPECT_NEAR(std::sqrt(sq_t / n), options.translation_sd, tolerance * options.translation_sd);
+  // Standard error of an AR(1) lag-one estimate: sqrt((1 − ρ²)/n) over 6 components.
+  EXPECT_NEAR(lag / lag_sq, options.correlation, 4 * std::sqrt((1 - 0.64) / (6.0 * frames)));
+}
+
+TEST(ErrorModelTest, LossAndGrossEpisodesHaveTheModelsRateAndLength) {
+  ErrorModelOptions options;
+  options.loss_rate = 0.01;
+  options.loss_mean_frames = 4;
+  options.gross_rate = 0.005;
+  options.gross_mean_frames = 6;
+  const int frames = 100000;
+  const Trajectory truth = Walk(frames);
+  const SimulatedTracking sim = SimulateTracking(truth, options, 11);
+  int loss_runs = 0, lost = 0, gross_runs = 0, gross = 0, loss_at_risk = 0, gross_at_risk = 0;
+  bool previous_gross = false;
+  for (int t = 0; t < frames; ++t) {
+    const bool is_lost = sim.status[t] == track::TrackStatus::kLost;
+    if (is_lost) {
+      ++lost;
+      if (t == 0 || sim.status[t - 1] != track::TrackStatus::kLost) ++loss_runs;
+      EXPECT_TRUE(t == 0 ||
+                  sim.tracked.poses[t].translation == sim.tracked.poses[t - 1].translation)
+          << "a lost frame holds the last pose";
+      previous_gross = false;
+      continue;
+    }
+    ++loss_at_risk;
+    const auto e = Error(truth.poses[t], sim.tracked.poses[t]);
+    const double angle = std::hypot(e[0], e[1], e[2]);
+    const bool is_gross = angle > 0.5;
+    if (is_gross) {
+      EXPECT_NEAR(angle, kPi, 0.1);
+      ++gross;
+      if (!previous_gross) ++gross_runs;
+    } else {
+      ++gross_at_risk;
+    }
+    previous_gross = is_gross;
+  }
+  // Episode counts are near Poisson: relative standard error 1/sqrt(count).
+  const double loss_rate = double(loss_runs) / loss_at_risk;
+  EXPECT_NEAR(loss_rate, options.loss_rate, 4 * options.loss_rate / std::sqrt(loss_runs));
+  // Geometric lengths: sd sqrt(1 − p)/p with p = 1/mean (runs that touch cut little).
+  const double loss_sd = std::sqrt(1 - 1 / options.loss_mean_frames) * options.loss_mean_frames;
+  EXPECT_NEAR(double(lost) / loss_runs, options.loss_mean_frames,
+              4 * loss_sd / std::sqrt(loss_runs) + 0.1);
+  const double gross_rate = double(gross_runs) / gross_at_risk;
+  EXPECT_NEAR(gross_rate, options.gross_rate, 4 * options.gross_rate / std::sqrt(gross_runs));
+  // Gross episodes are cut short by losses that follow them, so their mean length is a little
+  // below the option's; and above 1.
+  EXPECT_GT(double(gross) / gross_runs, 0.8 * options.gross_mean_frames);
+  EXPECT_LT(double(gross) / gross_runs, options.gross_mean_frames + 0.5);
+}
+
+TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
+  ErrorModelOptions options;
+  options.translation_sd = 0.0007;
+  options.rotation_sd = 0.009;
+  options.correlation = 0.7;
+  options.loss_rate = 0.004;
+  options.loss_mean_frames = 3;
+  options.gross_rate = 0.002;
+  options.gross_mean_frames = 4;
+  options.slider_sd = 0.15;
+  options.slider_correlation = 0.6;
+  options.slider_bias = 0.05;
+  options.slider_miss_share = 0.01;
+  std::vector<Trajectory> truths;
+  std::vector<SimulatedTracking> sims;
+  std::vector<Annotation> slider_truths;
+  std::vector<SimulatedReading> reads;
+  for (int take = 0; take < 10; ++take) {
+    truths.push_back(Walk(8000));
+    sims.push_back(SimulateTracking(truths.back(), options, 100 + take));
+    Annotation a;
+    for (int t = 0; t < 8000; ++t) {
+      a.timestamps.push_back(t / 30.0);
+      a.values.push_back(3 * std::sin(t / 200.0 + take));
+    }
+    slider_truths.push_back(a);
+    reads.push_back(SimulateSliderReading(a, options, 200 + take));
+  }
+  std::vector<TrackingObservation> tracking;
+  std::vector<ReadingObservation> readings;
+  for (int take = 0; take < 10; ++take) {
+    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status});
+    readings.push_back({&slider_truths[take], &reads[take].read, &reads[take].found});
+  }
+  const ErrorModelEstimate estimate = EstimateErrorModel(tracking, readings, ErrorModelOptions{});
+  const ErrorModelOptions& fit = estimate.options;
+  const double n = 3.0 * estimate.inlier_frames;
+  const double sd_tolerance = 4 * SdRelativeError(n, options.correlation);
+  EXPECT_NEAR(fit.translation_sd, options.translation_sd, sd_tolerance * options.translation_sd);
+  EXPECT_NEAR(fit.rotation_sd, options.rotation_sd, sd_tolerance * options.rotation_sd);
+  EXPECT_NEAR(fit.correlation, options.correlation, 4 * std::sqrt((1 - 0.49) / (2 * n)) + 0.005);
+  EXPECT_NEAR(fit.loss_rate, options.loss_rate,
+              4 * options.loss_rate / std::sqrt(estimate.loss_episodes));
+  EXPECT_NEAR(fit.loss_mean_frames, options.loss_mean_frames, 0.3);
+  EXPECT_NEAR(fit.gross_rate, options.gross_rate,
+              4 * options.gross_rate / std::sqrt(estimate.gross_episodes));
+  const double slider_n = double(estimate.slider_frames - estimate.slider_missed);
+  const double slider_rel = SdRelativeError(slider_n, options.slider_correlation);
+  EXPECT_NEAR(fit.slider_sd, options.slider_sd, 4 * slider_rel * options.slider_sd);
+  // The mean of an AR(1) sample: se = σ sqrt((1 + ρ)/((1 − ρ) n)).
+  EXPECT_NEAR(fit.slider_bias, options.slider_bias,
+              4 * options.slider_sd * std::sqrt(1.6 / (0.4 * slider_n)));
+  EXPECT_NEAR(fit.slider_correlation, options.slider_correlation, 0.02);
+  const double p = options.slider_miss_share;
+  EXPECT_NEAR(fit.slider_miss_share, p, 4 * std::sqrt(p * (1 - p) / estimate.slider_frames));
+}
+
+TEST(ErrorModelTest, SliderReadingStaysInRangeAndHoldsMissedFrames) {
+  ErrorModelOptions options;
+  options.slider_sd = 0.5;
+  options.slider_miss_share = 0.2;
+  Annotation truth;
+  for (int t = 0; t < 3000; ++t) {
+    truth.timestamps.push_back(t / 30.0);
+    truth.values.push_back(t % 600 < 300 ? 5.0 : -4.9);
+  }
+  const SimulatedReading read = SimulateSliderReading(truth, options, 3);
+  ASSERT_EQ(read.read.size(), truth.size());
+  int first_found = -1;
+  for (int t = 0; t < 3000; ++t) {
+    EXPECT_GE(read.read.values[t], kMinAnnotation);
+    EXPECT_LE(read.read.values[t], kMaxAnnotation);
+    if (read.found[t] && first_found < 0) first_found = t;
+    if (!read.found[t] && t > 0) {
+      EXPECT_EQ(read.read.values[t], read.read.values[t - 1]);
+    }
+  }
+  ASSERT_GE(first_found, 0);
+  for (int t = 0; t < first_found; ++t)
+    EXPECT_EQ(read.read.values[t], read.read.values[first_found]);
+  EXPECT_EQ(read.read.timestamps, truth.timestamps);
+}
+
+TEST(ErrorModelTest, DeterministicPerSeed) {
+  ErrorModelOptions options;
+  options.loss_rate = 0.01;
+  const Trajectory truth = Walk(2000);
+  const auto a = SimulateTracking(truth, options, 5);
+  const auto b = SimulateTracking(truth, options, 5);
+  const auto c = SimulateTracking(truth, options, 6);
+  bool differs = false;
+  for (std::size_t t = 0; t < truth.size(); ++t) {
+    EXPECT_EQ(a.tracked.poses[t].translation, b.tracked.poses[t].translation);
+    EXPECT_EQ(a.tracked.poses[t].rotation.coeffs(), b.tracked.poses[t].rotation.coeffs());
+    EXPECT_EQ(a.status[t], b.status[t]);
+    differs |= a.tracked.poses[t].translation != c.tracked.poses[t].translation;
+  }
+  EXPECT_TRUE(differs);
+  Annotation slider;
+  for (int t = 0; t < 500; ++t) {
+    slider.timestamps.push_back(t / 30.0);
+    slider.values.push_back(0.01 * t - 2);
+  }
+  EXPECT_EQ(SimulateSliderReading(slider, options, 9).read.values,
+            SimulateSliderReading(slider, options, 9).read.values);
+  EXPECT_NE(SimulateSliderReading(slider, options, 9).read.values,
+            SimulateSliderReading(slider, options, 10).read.values);
+}
+
+TEST(ErrorModelTest, BadOptionsNameTheField) {
+  ErrorModelOptions options;
+  options.correlation = 1.0;
+  try {
+    options.Validate("error_model");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("error_model.correlation"), std::string::npos) << e.what();
+  }
+  options = {};
+  options.loss_mean_frames = 0.5;
+  EXPECT_THROW(options.Validate("error_model"), InputError);
+  options = {};
+  options.translation_sd = std::nan("");
+  EXPECT_THROW(SimulateTracking(Walk(10), options, 1), InputError);
+  options = {};
+  options.slider_miss_share = 1.0;
+  EXPECT_THROW(options.Validate("error_model"), InputError);
+}
+
+TEST(ErrorModelTest, EstimatorRejectsMismatchedLengths) {
+  const Trajectory truth = Walk(10);
+  const Trajectory shorter = Walk(9);
+  const std::vector<track::TrackStatus> status(10, track::TrackStatus::kTracked);
+  EXPECT_THROW(EstimateErrorModel({{&truth, &shorter, &status}}, {}), InputError);
+}
+
+}  // namespace
+}  // namespace mmh::pipeline
