@@ -15,7 +15,8 @@
 //  3. per pixel, with noise from a counter-based generator keyed by (seed, frame, pixel), so that
 //     a frame is the same for any thread count and SIMD level: lateral noise (edge pixels take
 //     their neighbour's depth), axial noise sigma_z(z, theta) (Box-Muller normals), the disparity
-//     lattice, missing pixels (shadow, edges, grazing angles, range, speckle), and colour noise.
+//     lattice, missing pixels (shadow, edges, grazing angles, range, speckle), and colour noise
+//     (each noisy byte drawn exactly from its rounded, clamped normal by the alias method).
 // Sequences render fastest with RenderFrames (below): one scene and sensor per core.
 #pragma once
 

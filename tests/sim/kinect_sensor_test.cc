@@ -379,9 +379,13 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
   scene.SetPose(a, Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())),
                           Eigen::Vector3d(0.03, -0.02, 0.8)));
   scene.Commit();
-  for (bool quantise : {true, false}) {
+  // Colour noise of 1.5 (default), 2.5 and 12: tables of 32, 64 and 512 slots per value (looked
+  // up by one or two permutes, or gathered).
+  for (const auto& [quantise, read_noise] :
+       {std::pair{true, 1.5}, std::pair{false, 2.5}, std::pair{true, 12.0}}) {
     KinectSensorOptions options;
     options.quantise = quantise;
+    options.color.read_noise = read_noise;
     options.intrinsics.width = 333;  // rows that do not fill whole vectors
     options.intrinsics.cx = 166;
     KinectSensor vector_sensor(options, &scene, Rigid3::Identity());
@@ -398,8 +402,10 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
 }
 
 // Chi-squared goodness of fit of integer samples (offsets from their clean value) against a
-// normal N(0, sigma) rounded to integers (bins k = round(x); tails pooled where expected < 20).
-double RoundedNormalFitP(const std::vector<int>& offsets, double sigma) {
+// normal N(0, sigma) rounded to integers (bins k = round(x); tails pooled where expected < 20),
+// clamped to [lowest, highest] (the bins at the clamps take the whole tails beyond them).
+double RoundedNormalFitP(const std::vector<int>& offsets, double sigma, int lowest = -1000000,
+                         int highest = 1000000) {
   std::map<int, long> counts;
   for (int k : offsets) ++counts[k];
   const boost::math::normal normal(0.0, sigma);
@@ -409,9 +415,10 @@ double RoundedNormalFitP(const std::vector<int>& offsets, double sigma) {
   int bins = 0;
   long observed_tail = 0;
   double expected_tail = 0;
-  for (int k = -limit - 20; k <= limit + 20; ++k) {
-    const double expected =
-        n * (boost::math::cdf(normal, k + 0.5) - boost::math::cdf(normal, k - 0.5));
+  for (int k = std::max(-limit - 20, lowest); k <= std::min(limit + 20, highest); ++k) {
+    const double below = k == lowest ? 0.0 : boost::math::cdf(normal, k - 0.5);
+    const double up_to = k == highest ? 1.0 : boost::math::cdf(normal, k + 0.5);
+    const double expected = n * (up_to - below);
     const long observed = counts.count(k) ? counts[k] : 0;
     if (expected < 20) {
       observed_tail += observed;
@@ -470,8 +477,8 @@ TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
   const double sigma = std::sqrt(options.color.read_noise * options.color.read_noise +
                                  options.color.shot_gain * value);
   EXPECT_GT(RoundedNormalFitP(offsets, sigma), 1e-3);
-  // Neighbouring bytes (the two normals of one Box-Muller pair, and pairs next to each other)
-  // are uncorrelated: |r| below 4 standard errors.
+  // Neighbouring bytes (channels of one pixel, pixels next to each other) are uncorrelated: |r|
+  // below 4 standard errors.
   for (int lag : {1, 2, 3}) {
     double sxy = 0, sxx = 0;
     for (size_t i = 0; i + lag < offsets.size(); ++i) {
@@ -480,6 +487,36 @@ TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
     }
     EXPECT_LT(std::abs(sxy / sxx), 4 / std::sqrt(static_cast<double>(offsets.size())))
         << "lag " << lag;
+  }
+}
+
+// Near black and near white the noisy bytes clamp: the bins 0 and 255 hold the whole tails.
+TEST(KinectSensor, ColorNoiseClampsToTheByteRange) {
+  for (int albedo : {2, 252}) {
+    RayScene scene;
+    TriangleMesh wall = Quad(30, 30);
+    wall.face_colors.setConstant(2, 3, albedo);
+    scene.AddStatic("wall", wall, FacingCamera(1.2, -Eigen::Vector3d::UnitZ()));
+    scene.Commit();
+    KinectSensorOptions options;
+    options.seed = 21;
+    options.color.ambient = 1.0;  // linear light factor 1 + 0.75 n.l: a dark or bright value
+    options.color.diffuse = albedo < 128 ? 0.0 : 0.02;
+    KinectSensor noisy(options, &scene, Rigid3::Identity());
+    options.noise = false;
+    KinectSensor exact(options, &scene, Rigid3::Identity());
+    const RgbdFrame x = noisy.Render(1);
+    const RgbdFrame clean = exact.Render(1);
+    const int value = clean.rgb[0];
+    for (uint8_t c : clean.rgb) ASSERT_EQ(c, value);
+    ASSERT_TRUE(value <= 4 || value >= 251) << value;
+    std::vector<int> offsets(x.rgb.size());
+    for (size_t i = 0; i < x.rgb.size(); ++i) offsets[i] = static_cast<int>(x.rgb[i]) - value;
+    const double sigma = std::sqrt(options.color.read_noise * options.color.read_noise +
+                                   options.color.shot_gain * value);
+    EXPECT_GT(RoundedNormalFitP(offsets, sigma, -value, 255 - value), 1e-3) << "value " << value;
+    const auto clamped = std::count(x.rgb.begin(), x.rgb.end(), value < 128 ? 0 : 255);
+    EXPECT_GT(clamped, 1000) << "value " << value;
   }
 }
 
