@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/text_parsing.h"
 #include "pipeline/animator_run.h"
 #include "pipeline/run_metrics.h"
 #include "pipeline/run_output.h"
@@ -27,6 +28,7 @@ struct RunArgs {
   CommonFlags common;
   int animator = -1;
   long long seed = -1;
+  bool resume = false;
 };
 
 // A progress bar on a terminal (stderr), nothing otherwise.
@@ -55,11 +57,73 @@ class ProgressBar {
 
 }  // namespace
 
+namespace {
+
+// The first key path where `a` and `b` differ ("" when equal), with both values.
+std::string FirstDifference(const nlohmann::json& a, const nlohmann::json& b,
+                            const std::string& path, std::string* value_a, std::string* value_b) {
+  if (a.is_object() && b.is_object()) {
+    for (const auto& [key, value] : a.items()) {
+      const std::string p = path.empty() ? key : path + "." + key;
+      if (!b.contains(key)) {
+        *value_a = value.dump(), *value_b = "nothing";
+        return p;
+      }
+      const std::string d = FirstDifference(value, b[key], p, value_a, value_b);
+      if (!d.empty()) return d;
+    }
+    for (const auto& [key, value] : b.items()) {
+      if (!a.contains(key)) {
+        *value_a = "nothing", *value_b = value.dump();
+        return path.empty() ? key : path + "." + key;
+      }
+    }
+    return "";
+  }
+  if (a != b) {
+    *value_a = a.dump(), *value_b = b.dump();
+    return path.empty() ? "(the whole config)" : path;
+  }
+  return "";
+}
+
+// --resume continues a run whose sessions were made with the same config: only the sections
+// that come after the sessions (montage, metrics, run.min_tracked_share) may change.
+void CheckResumable(const std::filesystem::path& out, const nlohmann::json& resolved) {
+  const std::filesystem::path file = out / "config.resolved.json";
+  if (!std::filesystem::exists(file)) {
+    ThrowBadValue(file.string(), "missing",
+                  "the resolved config of an earlier run in this folder (--resume continues one)");
+  }
+  nlohmann::json earlier = nlohmann::json::parse(ReadTextFile(file), nullptr, false);
+  if (earlier.is_discarded() || !earlier.is_object()) {
+    ThrowBadValue(file.string(), "unreadable JSON", "the resolved config mmh run writes");
+  }
+  nlohmann::json now = resolved;
+  for (nlohmann::json* j : {&earlier, &now}) {
+    j->erase("montage");
+    j->erase("metrics");
+    if (j->contains("run")) (*j)["run"].erase("min_tracked_share");
+  }
+  std::string value_earlier, value_now;
+  const std::string key = FirstDifference(earlier, now, "", &value_earlier, &value_now);
+  if (!key.empty()) {
+    ThrowBadValue(file.string() + ": " + key, value_earlier,
+                  value_now +
+                      " as in this run's config (the sessions would differ; only "
+                      "montage, metrics and run.min_tracked_share may change with "
+                      "--resume)");
+  }
+}
+
+}  // namespace
+
 pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animator,
                                   const std::filesystem::path& out, bool progress_bar,
-                                  const std::vector<std::string>& argv, int threads) {
-  EnsureDirectory(out);
+                                  const std::vector<std::string>& argv, int threads, bool resume) {
   const nlohmann::json resolved = config.ToJson();
+  if (resume) CheckResumable(out, resolved);
+  EnsureDirectory(out);
   // The resolved config first: whatever fails later, the results beside it say what ran.
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
   ProgressBar bar(progress_bar, "run: animator " + std::to_string(animator));
@@ -69,7 +133,11 @@ pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animato
         config, animator, [&](std::int64_t done, std::int64_t total) { bar.Update(done, total); },
         [&](const pipeline::TakeRun& take, bool practice) {
           pipeline::WriteTakeRun(out, take, practice);
-        });
+        },
+        resume ? pipeline::TakeLoader([&](pipeline::TakeRun& take, bool practice) {
+          return pipeline::LoadTakeRun(out, take, practice);
+        })
+               : pipeline::TakeLoader());
   } catch (...) {
     // The takes that finished are on disk; say what ran.
     WriteFileAtomically(out / "run.json",
@@ -94,7 +162,7 @@ void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
   const std::filesystem::path out = args.common.out_dir;
   const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
   const pipeline::AnimatorRun run = RunScenario(run_config, run_config.render.render.animator, out,
-                                                bar, argv, args.common.threads);
+                                                bar, argv, args.common.threads, args.resume);
   if (args.common.quiet) return;
   const nlohmann::json& m = run.metrics;
   const nlohmann::json seconds = pipeline::SecondsToJson(run);
@@ -151,6 +219,9 @@ void AddRunCommand(CLI::App& app, const std::vector<std::string>& argv) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--resume", args->resume,
+                "Reuse the takes an earlier run in --out finished (same config but for montage, "
+                "metrics); run the rest");
   cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
   cmd->callback([args, argv] { RunRun(*args, argv); });
 }

@@ -255,7 +255,7 @@ void FillGaps(std::vector<Rigid3>& poses, const std::vector<bool>& estimated) {
 }
 
 AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress,
-                        const TakeDone& take_done) {
+                        const TakeDone& take_done, const TakeLoader& load) {
   const auto start = Clock::now();
   const sim::RenderConfig& render = config.render;
   const RunOptions& options = config.run;
@@ -307,6 +307,13 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     }
   }
   result.seconds.perform = SecondsSince(t0);
+  // Takes whose sessions an earlier run finished.
+  std::vector<bool> loaded(takes.size(), false);
+  if (load) {
+    for (size_t slot = 0; slot < takes.size(); ++slot) {
+      loaded[slot] = load(takes[slot], practice_takes && slot == 0);
+    }
+  }
 
   if (options.fidelity == Fidelity::kFull) {
     // Every session is its own job (scene, sensor, tracker); jobs run in parallel and each renders
@@ -326,6 +333,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     std::vector<SessionJob> jobs;
     std::int64_t total_frames = 0;
     for (size_t slot = 0; slot < takes.size(); ++slot) {
+      if (loaded[slot]) continue;
       const TakeRun& t = takes[slot];
       const bool is_practice = practice_takes && slot == 0;
       const int model = is_practice ? 1 : 0;
@@ -389,6 +397,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
   } else {
     t0 = Clock::now();
     for (TakeRun& t : takes) {
+      if (loaded[&t - takes.data()]) continue;
       const Trajectory full = t.performed.table_T_proxy;
       t.performed.table_T_proxy = t.truth;  // the error model sees the (possibly shortened) take
       SimulateSessions(config, seed, t);

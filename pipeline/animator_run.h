@@ -138,13 +138,19 @@ using Progress = std::function<void(std::int64_t done, std::int64_t total)>;
 // results of the stages that finished.
 using TakeDone = std::function<void(const TakeRun& take, bool practice)>;
 
+// Called once per take after it is performed (take.performed, truth and truth_annotation set):
+// returns true when it has filled in the take's session results (tracked, status, read
+// annotation, slider_found, camera poses) from an earlier run, so that its sessions are not run
+// again (`mmh run --resume`).
+using TakeLoader = std::function<bool(TakeRun& take, bool practice)>;
+
 // Runs participant `animator` of config.render.population through `config.run.takes` takes of
 // config.render.story (object config.render.object). Deterministic in the config, independent of
 // the thread count. Throws InputError for bad input (a missing story, takes too short for the
 // montage), and a RunError when a take's tracking failed (fewer than run.min_tracked_share of its
 // frames estimated), naming the take.
 AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress = {},
-                        const TakeDone& take_done = {});
+                        const TakeDone& take_done = {}, const TakeLoader& load = {});
 
 // A failure of the work (exit code 1), as opposed to bad input.
 class RunError : public std::runtime_error {

@@ -1,10 +1,12 @@
 #include "pipeline/run_output.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "core/annotation.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/text_parsing.h"
 #include "core/tum_io.h"
 #include "metrics/tracking_metrics.h"
 #include "pipeline/run_metrics.h"
@@ -32,6 +34,21 @@ void WriteMontage(const std::filesystem::path& dir, const montage::Montage& m,
   WriteFileAtomically(dir / "summary.json", summary.dump(2) + "\n");
 }
 
+nlohmann::json PoseToJson(const Rigid3& pose) {
+  return {{"translation", {pose.translation.x(), pose.translation.y(), pose.translation.z()}},
+          {"quaternion_xyzw",
+           {pose.rotation.x(), pose.rotation.y(), pose.rotation.z(), pose.rotation.w()}}};
+}
+
+Rigid3 PoseFromJson(const nlohmann::json& j) {
+  const auto& t = j.at("translation");
+  const auto& q = j.at("quaternion_xyzw");
+  return Rigid3(
+      Eigen::Quaterniond(q.at(3).get<double>(), q.at(0).get<double>(), q.at(1).get<double>(),
+                         q.at(2).get<double>()),
+      Eigen::Vector3d(t.at(0).get<double>(), t.at(1).get<double>(), t.at(2).get<double>()));
+}
+
 }  // namespace
 
 void WriteTakeRun(const std::filesystem::path& out, const TakeRun& take, bool practice) {
@@ -44,11 +61,14 @@ void WriteTakeRun(const std::filesystem::path& out, const TakeRun& take, bool pr
              "tracked table_T_proxy (lost frames interpolated; see status.csv)\n"
              "timestamp tx ty tz qx qy qz qw");
   }
+  const bool annotated = !take.slider_found.empty();
   std::ostringstream status;
-  status << "frame,timestamp,status\n";
+  status << "frame,timestamp,status" << (annotated ? ",slider_found" : "") << '\n';
   for (size_t i = 0; i < take.status.size(); ++i) {
     status << i << ',' << FormatNumber(take.truth.timestamps[i]) << ','
-           << track::TrackStatusName(take.status[i]) << '\n';
+           << track::TrackStatusName(take.status[i]);
+    if (annotated) status << ',' << (take.slider_found[i] ? 1 : 0);
+    status << '\n';
   }
   WriteFileAtomically(dir / "status.csv", status.str());
   if (!take.truth_annotation.values.empty()) {
@@ -67,6 +87,101 @@ void WriteTakeRun(const std::filesystem::path& out, const TakeRun& take, bool pr
     quality << '\n';
   }
   WriteFileAtomically(dir / "quality.csv", quality.str());
+  // Last: its presence marks the take's folder complete (mmh run --resume).
+  const nlohmann::json session = {
+      {"frames", static_cast<int>(take.truth.poses.size())},
+      {"camera_T_table", PoseToJson(take.camera_T_table)},
+      {"estimated_camera_T_table", PoseToJson(take.estimated_camera_T_table)}};
+  WriteFileAtomically(dir / "session.json", session.dump(2) + "\n");
+}
+
+bool LoadTakeRun(const std::filesystem::path& out, TakeRun& take, bool practice) {
+  const std::filesystem::path dir = TakeFolder(out, take, practice);
+  const bool annotated = !practice;
+  if (!std::filesystem::exists(dir / "session.json")) return false;
+  const int frames = static_cast<int>(take.truth.poses.size());
+  auto inconsistent = [&](const std::filesystem::path& file, const std::string& value,
+                          const std::string& expected) {
+    ThrowBadValue((dir / file).string(), value,
+                  expected +
+                      " (stage outputs inconsistent with this run: run without --resume "
+                      "or into a new folder)");
+  };
+  const nlohmann::json session =
+      nlohmann::json::parse(ReadTextFile(dir / "session.json"), nullptr, false);
+  if (session.is_discarded() || !session.is_object() || !session.contains("frames")) {
+    inconsistent("session.json", "unreadable", "the session summary mmh run writes");
+  }
+  if (session["frames"] != frames) {
+    inconsistent("session.json", session["frames"].dump() + " frames",
+                 std::to_string(frames) + " frames of the performed take");
+  }
+  for (const char* file : {"truth.tum", "tracked.tum", "status.csv"}) {
+    if (!std::filesystem::exists(dir / file)) inconsistent(file, "missing", "the file");
+  }
+  const Trajectory truth = ReadTum(dir / "truth.tum");
+  if (static_cast<int>(truth.poses.size()) != frames) {
+    inconsistent("truth.tum", std::to_string(truth.poses.size()) + " poses",
+                 std::to_string(frames) + " (the performed take's frames)");
+  }
+  for (int i = 0; i < frames; ++i) {
+    if ((truth.poses[i].translation - take.truth.poses[i].translation).norm() > 1e-6) {
+      inconsistent("truth.tum", "frame " + std::to_string(i) + " elsewhere",
+                   "the performed take's pose (another participant, take or config?)");
+    }
+  }
+  take.tracked = ReadTum(dir / "tracked.tum");
+  if (static_cast<int>(take.tracked.poses.size()) != frames) {
+    inconsistent("tracked.tum", std::to_string(take.tracked.poses.size()) + " poses",
+                 std::to_string(frames) + " (one per frame)");
+  }
+  take.status.clear();
+  take.slider_found.clear();
+  int row = 0;
+  const std::string text = ReadTextFile(dir / "status.csv");
+  std::istringstream lines(text);
+  std::string line;
+  std::getline(lines, line);  // header
+  while (std::getline(lines, line)) {
+    const auto fields = SplitCsvFields(Trim(line));
+    const std::string where = "status.csv line " + std::to_string(row + 2);
+    if (fields.size() != (annotated ? 4u : 3u)) {
+      inconsistent(where, "\"" + line + "\"",
+                   annotated ? "frame,timestamp,status,slider_found" : "frame,timestamp,status");
+    }
+    const std::string name(fields[2]);
+    if (name == "tracked") {
+      take.status.push_back(track::TrackStatus::kTracked);
+    } else if (name == "predicted") {
+      take.status.push_back(track::TrackStatus::kPredicted);
+    } else if (name == "lost") {
+      take.status.push_back(track::TrackStatus::kLost);
+    } else {
+      inconsistent(where, "\"" + name + "\"", "tracked, predicted or lost");
+    }
+    if (annotated) take.slider_found.push_back(fields[3] == "1");
+    ++row;
+  }
+  if (row != frames) {
+    inconsistent("status.csv", std::to_string(row) + " rows", std::to_string(frames) + " frames");
+  }
+  const auto estimated = std::count_if(take.status.begin(), take.status.end(),
+                                       [](auto s) { return s != track::TrackStatus::kLost; });
+  take.estimated_share = frames > 0 ? static_cast<double>(estimated) / frames : 0.0;
+  if (annotated) {
+    if (!std::filesystem::exists(dir / "read_annotation.csv")) {
+      inconsistent("read_annotation.csv", "missing", "the file");
+    }
+    take.read_annotation = ReadAnnotationCsv(dir / "read_annotation.csv");
+    if (static_cast<int>(take.read_annotation.values.size()) != frames) {
+      inconsistent("read_annotation.csv",
+                   std::to_string(take.read_annotation.values.size()) + " values",
+                   std::to_string(frames) + " (one per frame)");
+    }
+  }
+  take.camera_T_table = PoseFromJson(session["camera_T_table"]);
+  take.estimated_camera_T_table = PoseFromJson(session["estimated_camera_T_table"]);
+  return true;
 }
 
 std::string MetricsToCsv(const nlohmann::json& metrics) {

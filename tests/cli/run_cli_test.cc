@@ -77,6 +77,34 @@ TEST(RunCliTest, FailedTrackingKeepsTheFinishedStages) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out/metrics.json"));
 }
 
+// --resume reuses the finished takes (a montage option may change), and refuses a folder whose
+// config or files do not belong to the run.
+TEST(RunCliTest, ResumeReusesFinishedTakesAndRefusesInconsistentOnes) {
+  TempDir dir;
+  const auto out = dir / "out";
+  ASSERT_EQ(RunMmh(ShortRun(out)).exit_code, 0);
+  const std::string tracked = ReadBytes(out / "takes/take_1/tracked.tum");
+  auto r = RunMmh(ShortRun(out, "--resume --set montage.blend.window=5"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(ReadBytes(out / "takes/take_1/tracked.tum"), tracked);
+  const nlohmann::json run = nlohmann::json::parse(ReadBytes(out / "run.json"));
+  EXPECT_EQ(run["seconds"]["rendered_frames"], 0);  // nothing rendered again
+  r = RunMmh(ShortRun(out, "--resume --set tracker.verification.max_rms=0.003"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("config.resolved.json: tracker.verification.max_rms"), std::string::npos)
+      << r.output;
+  std::string status = ReadBytes(out / "takes/take_0/status.csv");
+  status.erase(status.rfind('\n', status.size() - 2) + 1);  // drop the last row
+  WriteText(out / "takes/take_0/status.csv", status);
+  r = RunMmh(ShortRun(out, "--resume"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("take_0/status.csv: got 69 rows, expected 70 frames"), std::string::npos)
+      << r.output;
+  r = RunMmh(ShortRun(dir / "empty", "--resume"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("config.resolved.json: got missing"), std::string::npos) << r.output;
+}
+
 // A baseline made by --update passes; a baseline value moved beyond its tolerance fails (exit 1)
 // and the table names the metric.
 TEST(RunCliTest, RegressPassesItsOwnBaselineAndCatchesAChange) {
