@@ -9,7 +9,12 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <functional>
 #include <memory>
+
+#include "core/library_versions.h"
+#include "sim/library_versions.h"
+#include "track/library_versions.h"
 
 #ifndef MMH_SOURCE_DIR
 #define MMH_SOURCE_DIR "."
@@ -72,6 +77,23 @@ nlohmann::json Provenance(const std::vector<std::string>& argv,
                             std::to_string(NLOHMANN_JSON_VERSION_PATCH)},
       {"compiler", __VERSION__},
   };
+  for (const nlohmann::json& more :
+       {mmh::LibraryVersions(), mmh::sim::LibraryVersions(), mmh::track::LibraryVersions()}) {
+    run["libraries"].update(more);
+  }
+  // Every seed of the resolved config, by key path (the run is a function of config and seeds).
+  nlohmann::json seeds = nlohmann::json::object();
+  std::function<void(const nlohmann::json&, const std::string&)> find_seeds =
+      [&](const nlohmann::json& j, const std::string& path) {
+        if (!j.is_object()) return;
+        for (const auto& [key, value] : j.items()) {
+          const std::string p = path.empty() ? key : path + "." + key;
+          if (key == "seed" && value.is_number()) seeds[p] = value;
+          find_seeds(value, p);
+        }
+      };
+  find_seeds(resolved_config, "");
+  run["seeds"] = seeds;
   const std::time_t now = std::time(nullptr);
   char stamp[32];
   std::strftime(stamp, sizeof(stamp), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));

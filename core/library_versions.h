@@ -1,0 +1,12 @@
+// Versions of the third-party libraries core/ uses inside its .cc files, for run.json (the CLI
+// never includes their headers).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+namespace mmh {
+
+// {"name": "version", ...}
+nlohmann::json LibraryVersions();
+
+}  // namespace mmh
