@@ -145,6 +145,7 @@ pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animato
     throw;
   }
   pipeline::WriteAnimatorRun(out, run);
+  WriteFileAtomically(out / "timings.csv", pipeline::TimingsToCsv(run));
   WriteFileAtomically(
       out / "run.json",
       Provenance(argv, resolved, threads, pipeline::SecondsToJson(run)).dump(2) + "\n");
@@ -196,7 +197,7 @@ void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
       seconds["render_track_frames_per_second"].get<double>());
   std::printf(
       "written: %s/{metrics.json, metrics.csv, tracking_frames.csv, seams.csv, takes/, "
-      "montage/, montage_truth/, config.resolved.json, run.json}\n",
+      "montage/, montage_truth/, timings.csv, config.resolved.json, run.json}\n",
       out.string().c_str());
 }
 

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "core/cross_correlation.h"
+#include "core/error.h"
 #include "metrics/annotation_metrics.h"
 #include "metrics/motion_metrics.h"
 #include "metrics/tracking_metrics.h"
@@ -350,6 +351,27 @@ nlohmann::json SecondsToJson(const AnimatorRun& run) {
           {"total", s.total},
           {"rendered_frames", run.rendered_frames},
           {"render_track_frames_per_second", sessions > 0 ? run.rendered_frames / sessions : 0.0}};
+}
+
+std::string TimingsToCsv(const AnimatorRun& run) {
+  const StageSeconds& s = run.seconds;
+  int record_frames = 0, annotate_frames = 0;
+  if (run.rendered_frames > 0) {
+    for (const TakeRun& t : run.takes) {
+      record_frames += static_cast<int>(t.status.size());
+      annotate_frames += static_cast<int>(t.read_annotation.values.size());
+    }
+    if (run.practice) record_frames += static_cast<int>(run.practice->status.size());
+  }
+  auto row = [](const char* stage, double seconds, int frames) {
+    return std::string(stage) + "," + FormatNumber(seconds) + "," + std::to_string(frames) + "," +
+           FormatNumber(seconds > 0 && frames > 0 ? frames / seconds : 0.0) + "\n";
+  };
+  return "stage,seconds,frames,frames_per_second\n" + row("perform", s.perform, 0) +
+         row("record", s.record, record_frames) + row("annotate", s.annotate, annotate_frames) +
+         row("render_and_track", s.record + s.annotate, run.rendered_frames) +
+         row("compose", s.compose, 0) + row("metrics", s.metrics, 0) +
+         row("total", s.total, run.rendered_frames);
 }
 
 std::vector<std::pair<std::string, double>> FlattenMetrics(const nlohmann::json& metrics) {

@@ -20,6 +20,10 @@ nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run
 // Time per stage [s] and frames per second (metrics.json "seconds").
 nlohmann::json SecondsToJson(const AnimatorRun& run);
 
+// The same as a tidy CSV: stage,seconds,frames,frames_per_second (frames: those the stage
+// rendered and tracked or read).
+std::string TimingsToCsv(const AnimatorRun& run);
+
 // metrics.json flattened to "a.b.c" keys (arrays indexed: "takes.0.tracking.success_rate"), in
 // key order; the tidy metrics.csv and `mmh regress` read it.
 std::vector<std::pair<std::string, double>> FlattenMetrics(const nlohmann::json& metrics);
