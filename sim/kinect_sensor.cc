@@ -124,9 +124,11 @@ std::vector<Bounds3> ClusterBounds(const TriangleMesh& mesh, int depth) {
   return boxes;
 }
 
-// Adds to each image row the column interval that a convex polygon (image coordinates, in order
-// around it) covers within one pixel: its x-extent over the band y in [v - 1, v + 1], widened by
-// one pixel.
+// Adds to each image row v the columns u whose pixel centre (u, v) lies in a convex polygon
+// (image coordinates, in order around it), widened by kCoverMargin px on every side: a camera
+// ray meets what projects into the polygon only through such a centre. The margin covers the
+// rounding of single-precision rays (about 1e-4 px here), with room to spare.
+constexpr double kCoverMargin = 0.05;
 void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, int height,
                         std::vector<std::vector<std::pair<int, int>>>* rows) {
   double y_min = 1e300, y_max = -1e300;
@@ -134,11 +136,11 @@ void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, 
     y_min = std::min(y_min, p.y());
     y_max = std::max(y_max, p.y());
   }
-  const int v0 = std::max(0, static_cast<int>(std::floor(y_min)) - 1);
-  const int v1 = std::min(height - 1, static_cast<int>(std::ceil(y_max)) + 1);
+  const int v0 = std::max(0, static_cast<int>(std::ceil(y_min - kCoverMargin)));
+  const int v1 = std::min(height - 1, static_cast<int>(std::floor(y_max + kCoverMargin)));
   const size_t n = polygon.size();
   for (int v = v0; v <= v1; ++v) {
-    const double lo = v - 1.0, hi = v + 1.0;
+    const double lo = v - kCoverMargin, hi = v + kCoverMargin;
     double x_min = 1e300, x_max = -1e300;
     for (size_t i = 0; i < n; ++i) {
       const Eigen::Vector2d& a = polygon[i];
@@ -162,8 +164,8 @@ void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, 
       }
     }
     if (x_min > x_max) continue;
-    const int u0 = std::max(0, static_cast<int>(std::floor(x_min)) - 1);
-    const int u1 = std::min(width - 1, static_cast<int>(std::ceil(x_max)) + 1);
+    const int u0 = std::max(0, static_cast<int>(std::ceil(x_min - kCoverMargin)));
+    const int u1 = std::min(width - 1, static_cast<int>(std::floor(x_max + kCoverMargin)));
     if (u0 > u1) continue;
     (*rows)[v].emplace_back(u0, u1);
   }
