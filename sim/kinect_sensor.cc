@@ -682,54 +682,91 @@ MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const floa
   }
 }
 
-// Where 16 bytes repeat with period 3 (pixels of one colour, the common case on flat-shaded
-// faces), the table rows of their three values are looked up by permutes (up to 64 slots)
-// instead of a gather, which costs about 24 cycles on Zen 4; both give the same entries.
+// The entries of `slot` in a table row of kSlots (32 or 64) slots, by permutes.
+template <int kSlots>
+MMH_AVX512 inline __m512i AliasLookup(const uint32_t* row, __m512i slot) {
+  const auto* r = reinterpret_cast<const __m512i*>(row);
+  const __m512i low =
+      _mm512_permutex2var_epi32(_mm512_loadu_si512(r), slot, _mm512_loadu_si512(r + 1));
+  if constexpr (kSlots <= 32) return low;
+  const __m512i high =
+      _mm512_permutex2var_epi32(_mm512_loadu_si512(r + 2), slot, _mm512_loadu_si512(r + 3));
+  return _mm512_mask_blend_epi32(_mm512_test_epi32_mask(slot, _mm512_set1_epi32(32)), low, high);
+}
+
+// Where bytes repeat with period 3 (pixels of one colour, the common case on flat-shaded faces),
+// the table rows of their three values are looked up by permutes (kSlots: 32 or 64 slots; 0: more,
+// gathers only) instead of a gather, which costs about 24 cycles on Zen 4; both give the same
+// entries. Sixteen pixels (48 bytes) of one colour share their three rows.
+template <int kSlots>
 MMH_AVX512 void ColorRowAvx512(const ColorParams& p, const uint8_t* in, uint32_t first_counter,
                                int n, uint8_t* out) {
-  const __m512i slot_mask = _mm512_set1_epi32((1 << p.slot_bits) - 1);
-  const __m512i half = _mm512_set1_epi32(1 << (p.slot_bits - 1));
-  const __m128i slot_shift = _mm_cvtsi32_si128(p.slot_bits);
-  const bool permutes = p.slot_bits <= 6;
-  // Lanes j = c (mod 3) hold the value of byte c.
+  const int bits = p.slot_bits;
+  const __m512i slot_mask = _mm512_set1_epi32((1 << bits) - 1);
+  const __m512i half = _mm512_set1_epi32(1 << (bits - 1));
+  const __m128i slot_shift = _mm_cvtsi32_si128(bits);
+  // Lanes j = m (mod 3).
   constexpr __mmask16 kPhase[3] = {0x9249, 0x2492, 0x4924};
-  int i = 0;
-  for (; i + 16 <= n; i += 16) {
-    const __m512i h = CounterHashx16(p.key, first_counter + static_cast<uint32_t>(i));
-    const __m128i bytes = _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i));
-    const __m512i value = _mm512_cvtepu8_epi32(bytes);
-    const __m512i slot = _mm512_and_si512(h, slot_mask);
-    __m512i entry;
-    if (permutes && i + 19 <= n &&
-        (_mm_cmpeq_epi8_mask(bytes, _mm_loadu_si128(reinterpret_cast<const __m128i*>(in + i + 3))) &
-         0x1fff) == 0x1fff) {
-      const __mmask16 high = _mm512_test_epi32_mask(slot, _mm512_set1_epi32(32));
-      entry = _mm512_setzero_si512();
-      for (int c = 0; c < 3; ++c) {
-        const auto* row = reinterpret_cast<const __m512i*>(
-            p.table + (static_cast<size_t>(in[i + c]) << p.slot_bits));
-        const __m512i low_half =
-            _mm512_permutex2var_epi32(_mm512_loadu_si512(row), slot, _mm512_loadu_si512(row + 1));
-        if (p.slot_bits <= 5) {
-          entry = _mm512_mask_mov_epi32(entry, kPhase[c], low_half);
-          continue;
-        }
-        const __m512i high_half = _mm512_permutex2var_epi32(_mm512_loadu_si512(row + 2), slot,
-                                                            _mm512_loadu_si512(row + 3));
-        entry = _mm512_mask_mov_epi32(entry, kPhase[c],
-                                      _mm512_mask_blend_epi32(high, low_half, high_half));
-      }
-    } else {
-      entry = _mm512_i32gather_epi32(_mm512_or_si512(_mm512_sll_epi32(value, slot_shift), slot),
-                                     reinterpret_cast<const int*>(p.table), 4);
-    }
+  auto load16 = [](const uint8_t* x)
+                    MMH_AVX512 { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(x)); };
+  auto row_of = [&](int i) MMH_AVX512 { return p.table + (static_cast<size_t>(in[i]) << bits); };
+  // Bytes i .. i + 15 from their hashes and entries.
+  auto finish = [&](int i, __m512i h, __m512i value, __m512i slot, __m512i entry) MMH_AVX512 {
     const __mmask16 take_own = _mm512_cmplt_epu32_mask(
         _mm512_srli_epi32(h, 32 - kColorThresholdBits), _mm512_srli_epi32(entry, 8));
     const __m512i own = _mm512_sub_epi32(_mm512_add_epi32(value, slot), half);
     // vpmovdb keeps the low byte: the alias of `entry`, or `own` (in [0, 255] when taken).
     _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i),
                      _mm512_cvtepi32_epi8(_mm512_mask_blend_epi32(take_own, entry, own)));
+  };
+  // Bytes i .. i + 15 on their own.
+  auto sixteen = [&](int i) MMH_AVX512 {
+    const __m512i h = CounterHashx16(p.key, first_counter + static_cast<uint32_t>(i));
+    const __m128i bytes = load16(in + i);
+    const __m512i value = _mm512_cvtepu8_epi32(bytes);
+    const __m512i slot = _mm512_and_si512(h, slot_mask);
+    __m512i entry;
+    if (kSlots != 0 && i + 19 <= n &&
+        (_mm_cmpeq_epi8_mask(bytes, load16(in + i + 3)) & 0x1fff) == 0x1fff) {
+      entry = AliasLookup<kSlots>(row_of(i), slot);
+      entry = _mm512_mask_blend_epi32(kPhase[1], entry, AliasLookup<kSlots>(row_of(i + 1), slot));
+      entry = _mm512_mask_blend_epi32(kPhase[2], entry, AliasLookup<kSlots>(row_of(i + 2), slot));
+    } else {
+      entry = _mm512_i32gather_epi32(_mm512_or_si512(_mm512_sll_epi32(value, slot_shift), slot),
+                                     reinterpret_cast<const int*>(p.table), 4);
+    }
+    finish(i, h, value, slot, entry);
+  };
+  int i = 0;
+  if constexpr (kSlots != 0) {
+    for (; i + 51 <= n; i += 48) {
+      __m128i bytes[3];
+      bool run = true;
+      for (int k = 0; k < 3; ++k) {
+        bytes[k] = load16(in + i + 16 * k);
+        const __mmask16 same = _mm_cmpeq_epi8_mask(bytes[k], load16(in + i + 16 * k + 3));
+        run = run && (same | (k == 2 ? 0xe000 : 0)) == 0xffff;
+      }
+      if (!run) {
+        for (int k = 0; k < 3; ++k) sixteen(i + 16 * k);
+        continue;
+      }
+      const uint32_t* rows[3] = {row_of(i), row_of(i + 1), row_of(i + 2)};
+      for (int k = 0; k < 3; ++k) {
+        const int at = i + 16 * k;
+        const __m512i h = CounterHashx16(p.key, first_counter + static_cast<uint32_t>(at));
+        const __m512i slot = _mm512_and_si512(h, slot_mask);
+        // Lane j of block k is byte 16 k + j, channel (k + j) mod 3.
+        __m512i entry = AliasLookup<kSlots>(rows[0], slot);
+        entry =
+            _mm512_mask_blend_epi32(kPhase[(4 - k) % 3], entry, AliasLookup<kSlots>(rows[1], slot));
+        entry =
+            _mm512_mask_blend_epi32(kPhase[(5 - k) % 3], entry, AliasLookup<kSlots>(rows[2], slot));
+        finish(at, h, _mm512_cvtepu8_epi32(bytes[k]), slot, entry);
+      }
+    }
   }
+  for (; i + 16 <= n; i += 16) sixteen(i);
   ColorRowPortable(p, in + i, first_counter + static_cast<uint32_t>(i), n - i, out + i);
 }
 // The occlusion scans of OccludeRow, 16 pixels at a time: exclusive suffix minima (prefix
@@ -827,7 +864,13 @@ void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, i
               uint8_t* out) {
 #if MMH_SENSOR_AVX512
   if (UseAvx512().load(std::memory_order_relaxed)) {
-    ColorRowAvx512(p, in, first_counter, n, out);
+    if (p.slot_bits <= 5) {
+      ColorRowAvx512<32>(p, in, first_counter, n, out);
+    } else if (p.slot_bits == 6) {
+      ColorRowAvx512<64>(p, in, first_counter, n, out);
+    } else {
+      ColorRowAvx512<0>(p, in, first_counter, n, out);
+    }
     return;
   }
 #endif
