@@ -55,25 +55,18 @@ double LinearToSrgb(double c) {
 }
 constexpr int kEncodeSteps = 4096;
 
-// Spans of the union of column intervals per row (overlapping or touching ones merged).
-std::vector<PixelSpan> MergeRowIntervals(std::vector<std::vector<std::pair<int, int>>>& rows) {
+// The union of row intervals (overlapping or touching ones merged), ordered by row and column.
+std::vector<PixelSpan> MergeRowIntervals(std::vector<PixelSpan> intervals) {
+  std::sort(intervals.begin(), intervals.end(), [](const PixelSpan& x, const PixelSpan& y) {
+    return x.row < y.row || (x.row == y.row && x.first < y.first);
+  });
   std::vector<PixelSpan> spans;
-  for (int v = 0; v < static_cast<int>(rows.size()); ++v) {
-    std::vector<std::pair<int, int>>& row = rows[v];
-    if (row.empty()) continue;
-    std::sort(row.begin(), row.end());
-    int first = row[0].first;
-    int last = row[0].second;
-    for (size_t i = 1; i < row.size(); ++i) {
-      if (row[i].first <= last + 1) {
-        last = std::max(last, row[i].second);
-      } else {
-        spans.push_back({v, first, last});
-        first = row[i].first;
-        last = row[i].second;
-      }
+  for (const PixelSpan& s : intervals) {
+    if (!spans.empty() && spans.back().row == s.row && s.first <= spans.back().last + 1) {
+      spans.back().last = std::max(spans.back().last, s.last);
+    } else {
+      spans.push_back(s);
     }
-    spans.push_back({v, first, last});
   }
   return spans;
 }
@@ -130,7 +123,7 @@ std::vector<Bounds3> ClusterBounds(const TriangleMesh& mesh, int depth) {
 // rounding of single-precision rays (about 1e-4 px here), with room to spare.
 constexpr double kCoverMargin = 0.05;
 void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, int height,
-                        std::vector<std::vector<std::pair<int, int>>>* rows) {
+                        std::vector<PixelSpan>* rows) {
   double y_min = 1e300, y_max = -1e300;
   for (const Eigen::Vector2d& p : polygon) {
     y_min = std::min(y_min, p.y());
@@ -167,7 +160,7 @@ void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, 
     const int u0 = std::max(0, static_cast<int>(std::ceil(x_min - kCoverMargin)));
     const int u1 = std::min(width - 1, static_cast<int>(std::floor(x_max + kCoverMargin)));
     if (u0 > u1) continue;
-    (*rows)[v].emplace_back(u0, u1);
+    rows->push_back({v, u0, u1});
   }
 }
 
@@ -1280,12 +1273,13 @@ struct KinectSensor::Impl {
     const Rigid3 view_T_world = view.world_T_view.Inverse();
     const PinholeIntrinsics& k = view.intrinsics;
     std::vector<ObjectSpans> result;
-    std::vector<std::vector<std::pair<int, int>>> union_rows(k.height);
+    std::vector<PixelSpan> union_rows;
     std::vector<Eigen::Vector2d> corners(8);
+    std::vector<PixelSpan> rows;
     for (int o = 0; o < scene->object_count(); ++o) {
       if (!moving[o] || scene->WorldBounds(o).empty()) continue;
       const Rigid3 view_T_object = view_T_world * scene->world_T_object(o);
-      std::vector<std::vector<std::pair<int, int>>> rows(k.height);
+      rows.clear();
       bool behind = false;
       for (const Bounds3& box : moving_clusters[o]) {
         for (int corner = 0; corner < 8 && !behind; ++corner) {
@@ -1300,20 +1294,11 @@ struct KinectSensor::Impl {
         CoverConvexPolygon(ConvexHull(corners), k.width, k.height, &rows);
       }
       ObjectSpans object{static_cast<uint32_t>(o), {}};
-      if (behind) {
-        object.spans = FullImageSpans(k);
-      } else {
-        for (int v = 0; v < k.height; ++v) {
-          union_rows[v].insert(union_rows[v].end(), rows[v].begin(), rows[v].end());
-        }
-        object.spans = MergeRowIntervals(rows);
-      }
+      object.spans = behind ? FullImageSpans(k) : MergeRowIntervals(rows);
+      union_rows.insert(union_rows.end(), object.spans.begin(), object.spans.end());
       if (!object.spans.empty()) result.push_back(std::move(object));
-      if (behind) {
-        for (int v = 0; v < k.height; ++v) union_rows[v].emplace_back(0, k.width - 1);
-      }
     }
-    *all = MergeRowIntervals(union_rows);
+    *all = MergeRowIntervals(std::move(union_rows));
     return result;
   }
 
