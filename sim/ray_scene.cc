@@ -52,8 +52,8 @@ void ToEmbreeTransform(const Rigid3& a_T_b, float out[12]) {
 
 // Directions of a 4x4 tile's rays: column part of the tile's columns plus row part of its rows
 // (per component; `columns` and `rows` point at the tile's first column and row).
-MMH_SIMD_CLONES void TileDirections(const float* __restrict columns, const float* __restrict rows,
-                                    float* __restrict out) {
+inline void TileDirections(const float* __restrict columns, const float* __restrict rows,
+                           float* __restrict out) {
   for (int r = 0; r < kTile; ++r) {
     for (int c = 0; c < kTile; ++c) out[r * kTile + c] = columns[c] + rows[r];
   }
@@ -61,10 +61,10 @@ MMH_SIMD_CLONES void TileDirections(const float* __restrict columns, const float
 
 // Unit normals facing the camera and incidence cosines of 16 lanes (lanes without a hit compute
 // values nobody reads; no traps).
-MMH_SIMD_CLONES void FinishLanes(const float* __restrict nx_in, const float* __restrict ny_in,
-                                 const float* __restrict nz_in, const float* __restrict dx_in,
-                                 const float* __restrict dy_in, const float* __restrict dz_in,
-                                 const float* __restrict tfar, HitPacket* __restrict out) {
+inline void FinishLanes(const float* __restrict nx_in, const float* __restrict ny_in,
+                        const float* __restrict nz_in, const float* __restrict dx_in,
+                        const float* __restrict dy_in, const float* __restrict dz_in,
+                        const float* __restrict tfar, HitPacket* __restrict out) {
   for (int i = 0; i < HitPacket::kLanes; ++i) {
     const float nx = nx_in[i], ny = ny_in[i], nz = nz_in[i];
     const float dx = dx_in[i], dy = dy_in[i], dz = dz_in[i];
@@ -84,8 +84,7 @@ MMH_SIMD_CLONES void FinishLanes(const float* __restrict nx_in, const float* __r
 }
 
 // Normals of a packet from an object's frame to the world.
-MMH_SIMD_CLONES void RotateNormals(const Eigen::Matrix3f& world_R_frame,
-                                   HitPacket* __restrict out) {
+inline void RotateNormals(const Eigen::Matrix3f& world_R_frame, HitPacket* __restrict out) {
   float r[9];
   for (int row = 0; row < 3; ++row) {
     for (int col = 0; col < 3; ++col) r[3 * row + col] = world_R_frame(row, col);
@@ -469,6 +468,130 @@ void RayScene::CastObject(uint32_t object, const PinholeIntrinsics& intrinsics,
   impl_->Check();
 }
 
+namespace {
+
+// What the tiles of one CastRays call share (see there).
+struct TileCast {
+  enum Kind { kStatic, kInstanced, kFixed };
+  RTCScene scene = nullptr;
+  Kind kind = kStatic;
+  uint32_t fixed_object = kNoObject;
+  Eigen::Vector3f origin;
+  Eigen::Matrix3f world_R_frame;
+  const int* tiles = nullptr;  // indices into tile_mask
+  const uint16_t* tile_mask = nullptr;
+  int tx0 = 0, ty0 = 0, rect_width = 0, width = 0, padded_width = 0, padded_height = 0;
+  const float* column_part = nullptr;  // 3 by padded_width
+  const float* row_part = nullptr;     // 3 by padded_height
+  const float* max_depth = nullptr;    // null: unbounded rays
+  const uint32_t* instance_object = nullptr;
+  const uint32_t* static_geometry_object = nullptr;
+  const uint8_t* object_moving = nullptr;
+  const Eigen::Matrix3f* world_R_object = nullptr;
+  HitSink* sink = nullptr;
+};
+
+// Casts tiles [first, last) of c.tiles and hands their packets to the sink; returns the number of
+// rays. Cloned per x86-64 level (MMH_SIMD_CLONES) with the lane loops it inlines, so that they
+// vectorise with no dispatch per packet.
+MMH_SIMD_CLONES uint64_t CastTiles(const TileCast& c, size_t first, size_t last) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  uint64_t rays = 0;
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[16];
+  HitPacket out;
+  // Lane constants: Embree writes only tfar and the hit.
+  for (int i = 0; i < 16; ++i) {
+    packet.ray.org_x[i] = c.origin.x();
+    packet.ray.org_y[i] = c.origin.y();
+    packet.ray.org_z[i] = c.origin.z();
+    packet.ray.tnear[i] = 0.0f;
+    packet.ray.time[i] = 0.0f;
+    packet.ray.mask[i] = 0xffffffffu;
+    packet.ray.id[i] = i;
+    packet.ray.flags[i] = 0;
+  }
+  alignas(64) float normal_x[16], normal_y[16], normal_z[16];
+  for (size_t k = first; k != last; ++k) {
+    const int tile = c.tiles[k];
+    const int u0 = (c.tx0 + tile % c.rect_width) * kTile;
+    const int v0 = (c.ty0 + tile / c.rect_width) * kTile;
+    const uint16_t mask = c.tile_mask[tile];
+    for (int i = 0; i < 16; ++i) {
+      valid[i] = ((mask >> i) & 1u) ? -1 : 0;
+      packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
+      packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    TileDirections(&c.column_part[u0], &c.row_part[v0], packet.ray.dir_x);
+    TileDirections(&c.column_part[c.padded_width + u0], &c.row_part[c.padded_height + v0],
+                   packet.ray.dir_y);
+    TileDirections(&c.column_part[2 * c.padded_width + u0], &c.row_part[2 * c.padded_height + v0],
+                   packet.ray.dir_z);
+    if (c.max_depth != nullptr) {
+      for (int i = 0; i < 16; ++i) {
+        if ((mask >> i) & 1u) {
+          packet.ray.tfar[i] =
+              c.max_depth[static_cast<size_t>(v0 + i / kTile) * c.width + u0 + i % kTile];
+        }
+      }
+    }
+    rays += std::popcount(static_cast<unsigned>(mask));
+    rtcIntersect16(valid, c.scene, &context, &packet);
+    out.u0 = u0;
+    out.v0 = v0;
+    out.cast = mask;
+    uint32_t hit = 0;
+    for (int i = 0; i < 16; ++i) {
+      const bool lane_hit = valid[i] != 0 && packet.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+      hit |= static_cast<uint32_t>(lane_hit) << i;
+    }
+    out.hit = hit;
+    const float* nx = packet.hit.Ng_x;
+    const float* ny = packet.hit.Ng_y;
+    const float* nz = packet.hit.Ng_z;
+    if (c.kind == TileCast::kInstanced) {
+      // Object-space normals of instances to world.
+      std::copy_n(packet.hit.Ng_x, 16, normal_x);
+      std::copy_n(packet.hit.Ng_y, 16, normal_y);
+      std::copy_n(packet.hit.Ng_z, 16, normal_z);
+      for (uint32_t bits = hit; bits != 0; bits &= bits - 1) {
+        const int i = std::countr_zero(bits);
+        uint32_t object = c.instance_object[packet.hit.instID[0][i]];
+        if (object == kNoObject) object = c.static_geometry_object[packet.hit.geomID[i]];
+        out.object[i] = object;
+        if (!c.object_moving[object]) continue;
+        const Eigen::Vector3f normal =
+            c.world_R_object[object] *
+            Eigen::Vector3f(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]);
+        normal_x[i] = normal.x();
+        normal_y[i] = normal.y();
+        normal_z[i] = normal.z();
+      }
+      nx = normal_x;
+      ny = normal_y;
+      nz = normal_z;
+    } else if (c.kind == TileCast::kFixed) {
+      std::fill_n(out.object, 16, c.fixed_object);
+    } else {
+      for (uint32_t bits = hit; bits != 0; bits &= bits - 1) {
+        const int i = std::countr_zero(bits);
+        out.object[i] = c.static_geometry_object[packet.hit.geomID[i]];
+      }
+    }
+    std::copy_n(packet.hit.primID, 16, out.face);
+    FinishLanes(nx, ny, nz, packet.ray.dir_x, packet.ray.dir_y, packet.ray.dir_z, packet.ray.tfar,
+                &out);
+    if (c.kind == TileCast::kFixed) RotateNormals(c.world_R_frame, &out);
+    c.sink->Consume(out);
+  }
+  return rays;
+}
+
+}  // namespace
+
 void RayScene::Impl::CastRays(RTCScene scene, Lookup lookup, uint32_t fixed_object,
                               const Rigid3& frame_T_camera, const Eigen::Matrix3f& world_R_frame,
                               const PinholeIntrinsics& intrinsics, std::span<const PixelSpan> spans,
@@ -545,103 +668,37 @@ void RayScene::Impl::CastRays(RTCScene scene, Lookup lookup, uint32_t fixed_obje
         world_R_camera.col(2);
     for (int k = 0; k < 3; ++k) row_part[k * padded_height + v] = r[k];
   }
+  TileCast c;
+  c.scene = scene;
+  c.kind = lookup == Lookup::kFixed ? TileCast::kFixed
+           : instanced              ? TileCast::kInstanced
+                                    : TileCast::kStatic;
+  c.fixed_object = fixed_object;
+  c.origin = origin;
+  c.world_R_frame = world_R_frame;
+  c.tiles = tiles.data();
+  c.tile_mask = tile_mask.data();
+  c.tx0 = tx0;
+  c.ty0 = ty0;
+  c.rect_width = rect_width;
+  c.width = width;
+  c.padded_width = padded_width;
+  c.padded_height = padded_height;
+  c.column_part = column_part.data();
+  c.row_part = row_part.data();
+  c.max_depth = max_depth;
+  c.instance_object = instance_object.data();
+  c.static_geometry_object = s.static_geometry_object.data();
+  std::vector<uint8_t> moving(s.objects.size());
+  for (size_t i = 0; i < s.objects.size(); ++i) moving[i] = s.objects[i].moving;
+  c.object_moving = moving.data();
+  c.world_R_object = world_R_object.data();
+  c.sink = sink;
   std::atomic<uint64_t> cast{0};
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, tiles.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
-        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        uint64_t local_rays = 0;
-        alignas(64) RTCRayHit16 packet;
-        alignas(64) int valid[16];
-        HitPacket out;
-        // Lane constants: Embree writes only tfar and the hit.
-        for (int i = 0; i < 16; ++i) {
-          packet.ray.org_x[i] = origin.x();
-          packet.ray.org_y[i] = origin.y();
-          packet.ray.org_z[i] = origin.z();
-          packet.ray.tnear[i] = 0.0f;
-          packet.ray.time[i] = 0.0f;
-          packet.ray.mask[i] = 0xffffffffu;
-          packet.ray.id[i] = i;
-          packet.ray.flags[i] = 0;
-        }
-        alignas(64) float normal_x[16], normal_y[16], normal_z[16];
-        for (size_t k = r.begin(); k != r.end(); ++k) {
-          const int tile = tiles[k];
-          const int u0 = (tx0 + tile % rect_width) * kTile;
-          const int v0 = (ty0 + tile / rect_width) * kTile;
-          const uint16_t mask = tile_mask[tile];
-          for (int i = 0; i < 16; ++i) {
-            valid[i] = ((mask >> i) & 1u) ? -1 : 0;
-            packet.ray.tfar[i] = std::numeric_limits<float>::infinity();
-            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-          }
-          TileDirections(&column_part[u0], &row_part[v0], packet.ray.dir_x);
-          TileDirections(&column_part[padded_width + u0], &row_part[padded_height + v0],
-                         packet.ray.dir_y);
-          TileDirections(&column_part[2 * padded_width + u0], &row_part[2 * padded_height + v0],
-                         packet.ray.dir_z);
-          if (max_depth != nullptr) {
-            for (int i = 0; i < 16; ++i) {
-              if ((mask >> i) & 1u) {
-                packet.ray.tfar[i] =
-                    max_depth[static_cast<size_t>(v0 + i / kTile) * width + u0 + i % kTile];
-              }
-            }
-          }
-          local_rays += std::popcount(static_cast<unsigned>(mask));
-          rtcIntersect16(valid, scene, &context, &packet);
-          out.u0 = u0;
-          out.v0 = v0;
-          out.cast = mask;
-          uint32_t hit = 0;
-          for (int i = 0; i < 16; ++i) {
-            const bool lane_hit = valid[i] && packet.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-            hit |= static_cast<uint32_t>(lane_hit) << i;
-          }
-          out.hit = hit;
-          const float* nx = packet.hit.Ng_x;
-          const float* ny = packet.hit.Ng_y;
-          const float* nz = packet.hit.Ng_z;
-          if (instanced) {
-            // Object-space normals of instances to world.
-            std::copy_n(packet.hit.Ng_x, 16, normal_x);
-            std::copy_n(packet.hit.Ng_y, 16, normal_y);
-            std::copy_n(packet.hit.Ng_z, 16, normal_z);
-            for (uint32_t bits = hit; bits != 0; bits &= bits - 1) {
-              const int i = std::countr_zero(bits);
-              uint32_t object = instance_object[packet.hit.instID[0][i]];
-              if (object == kNoObject) object = s.static_geometry_object[packet.hit.geomID[i]];
-              out.object[i] = object;
-              if (!s.objects[object].moving) continue;
-              const Eigen::Vector3f normal =
-                  world_R_object[object] *
-                  Eigen::Vector3f(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]);
-              normal_x[i] = normal.x();
-              normal_y[i] = normal.y();
-              normal_z[i] = normal.z();
-            }
-            nx = normal_x;
-            ny = normal_y;
-            nz = normal_z;
-          } else if (lookup == Lookup::kFixed) {
-            std::fill_n(out.object, 16, fixed_object);
-          } else {
-            for (int i = 0; i < 16; ++i) {
-              out.object[i] =
-                  ((hit >> i) & 1u) ? s.static_geometry_object[packet.hit.geomID[i]] : kNoObject;
-            }
-          }
-          std::copy_n(packet.hit.primID, 16, out.face);
-          FinishLanes(nx, ny, nz, packet.ray.dir_x, packet.ray.dir_y, packet.ray.dir_z,
-                      packet.ray.tfar, &out);
-          if (lookup == Lookup::kFixed) RotateNormals(world_R_frame, &out);
-          sink->Consume(out);
-        }
-        cast.fetch_add(local_rays, std::memory_order_relaxed);
-      });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles.size(), 64),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      cast.fetch_add(CastTiles(c, r.begin(), r.end()), std::memory_order_relaxed);
+                    });
   rays.fetch_add(cast.load());
 }
 
