@@ -118,9 +118,15 @@ BENCHMARK(BM_SensorFrame)
     ->UseRealTime();
 
 // Frame-level parallelism (mmh::sim::RenderFrames): one scene and sensor per worker, 120 frames
-// of the demo walk per iteration. Args: mode, workers.
+// of the demo walk per iteration. Args: mode, workers, cores (0: all; 1: everything on one
+// thread, as one job of the pipeline renders its session).
 void BM_SensorFrames(benchmark::State& state) {
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
+  std::unique_ptr<tbb::global_control> limit;
+  if (state.range(2) > 0) {
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  state.range(2));
+  }
   const int count = 120;
   std::vector<mmh::sim::SensorWorker> workers;
   for (int w = 0; w < state.range(1); ++w) {
@@ -143,9 +149,11 @@ void BM_SensorFrames(benchmark::State& state) {
   Report(state, mmh::sim::TotalTimings(workers), first, ProcessSeconds() - cpu0);
 }
 BENCHMARK(BM_SensorFrames)
-    ->ArgNames({"full", "workers"})
-    ->Args({0, 2})
-    ->Args({1, 2})
+    ->ArgNames({"full", "workers", "cores"})
+    ->Args({0, 1, 1})
+    ->Args({0, 2, 0})
+    ->Args({1, 1, 1})
+    ->Args({1, 2, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
