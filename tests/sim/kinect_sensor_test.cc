@@ -496,19 +496,23 @@ TEST(KinectSensor, DepthNoiseIsNormalWithTheModelledSigma) {
   EXPECT_GT(RoundedNormalFitP(offsets, sigma_units), 1e-3);
 }
 
-TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
+// Frame 1 of a flat wall of one albedo facing the camera at 1.2 m, with noise and without.
+std::pair<RgbdFrame, RgbdFrame> NoisyAndCleanWall(int albedo, KinectSensorOptions options) {
   RayScene scene;
   TriangleMesh wall = Quad(30, 30);
-  wall.face_colors.setConstant(2, 3, 170);
+  wall.face_colors.setConstant(2, 3, albedo);
   scene.AddStatic("wall", wall, FacingCamera(1.2, -Eigen::Vector3d::UnitZ()));
   scene.Commit();
-  KinectSensorOptions options;
-  options.seed = 9;
   KinectSensor noisy(options, &scene, Rigid3::Identity());
   options.noise = false;
   KinectSensor exact(options, &scene, Rigid3::Identity());
-  const RgbdFrame x = noisy.Render(1);
-  const RgbdFrame clean = exact.Render(1);
+  return {noisy.Render(1), exact.Render(1)};
+}
+
+TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
+  KinectSensorOptions options;
+  options.seed = 9;
+  const auto [x, clean] = NoisyAndCleanWall(170, options);
   const int value = clean.rgb[0];
   for (uint8_t c : clean.rgb) ASSERT_EQ(c, value);  // flat wall, flat shading
   ASSERT_GT(value, 30);
@@ -534,20 +538,12 @@ TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
 // Near black and near white the noisy bytes clamp: the bins 0 and 255 hold the whole tails.
 TEST(KinectSensor, ColorNoiseClampsToTheByteRange) {
   for (int albedo : {2, 252}) {
-    RayScene scene;
-    TriangleMesh wall = Quad(30, 30);
-    wall.face_colors.setConstant(2, 3, albedo);
-    scene.AddStatic("wall", wall, FacingCamera(1.2, -Eigen::Vector3d::UnitZ()));
-    scene.Commit();
     KinectSensorOptions options;
     options.seed = 21;
-    options.color.ambient = 1.0;  // linear light factor 1 + 0.75 n.l: a dark or bright value
+    // Linear light factor about 1: the albedo's own (dark or bright) value.
+    options.color.ambient = 1.0;
     options.color.diffuse = albedo < 128 ? 0.0 : 0.02;
-    KinectSensor noisy(options, &scene, Rigid3::Identity());
-    options.noise = false;
-    KinectSensor exact(options, &scene, Rigid3::Identity());
-    const RgbdFrame x = noisy.Render(1);
-    const RgbdFrame clean = exact.Render(1);
+    const auto [x, clean] = NoisyAndCleanWall(albedo, options);
     const int value = clean.rgb[0];
     for (uint8_t c : clean.rgb) ASSERT_EQ(c, value);
     ASSERT_TRUE(value <= 4 || value >= 251) << value;
