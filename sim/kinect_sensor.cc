@@ -813,8 +813,10 @@ MMH_AVX512 void OcclusionScanAvx512(const float* us, int n, uint8_t* occluded) {
     const __m128i old = _mm_loadu_si128(reinterpret_cast<const __m128i*>(occluded + i));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(occluded + i),
                      _mm_or_si128(old, _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(hidden, 1))));
-    const __m512 all = Extremum<kFromRight>(x, carry);
-    carry = Set(kFromRight ? _mm512_reduce_min_ps(all) : _mm512_reduce_max_ps(all));
+    // The block's own extremum does not wait for the carry: the only chain from block to block
+    // is one min (max), not a whole reduction.
+    const float block_extremum = kFromRight ? _mm512_reduce_min_ps(x) : _mm512_reduce_max_ps(x);
+    carry = Extremum<kFromRight>(carry, Set(block_extremum));
   }
 }
 #undef MMH_AVX512
