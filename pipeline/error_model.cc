@@ -15,7 +15,15 @@ constexpr double kPi = 3.14159265358979323846;
 
 // Random streams of one simulated take, so that changing one part of the model leaves the draws
 // of the others alone.
-enum Stream : std::uint64_t { kPoseStream = 1, kGrossStream, kLossStream, kSliderStream };
+enum Stream : std::uint64_t {
+  kPoseStream = 1,
+  kFlipStream,
+  kLossStream,
+  kSliderStream,
+  kSpikeStream,
+  kFlipShapeStream,
+  kSpikeShapeStream
+};
 
 void RequireCorrelation(double value, const std::string& where) {
   RequireFinite(value, where);
@@ -43,23 +51,38 @@ class Ar1 {
   bool started_ = false;
 };
 
-// Marks the frames of episodes that start at each free frame with probability `rate` and last a
-// geometric number of frames with mean `mean_frames`. Frames already marked in `busy` neither
-// start nor extend an episode.
-std::vector<bool> DrawEpisodes(int frames, double rate, double mean_frames,
-                               const std::vector<bool>& busy, std::uint64_t seed) {
-  std::vector<bool> in_episode(frames, false);
+// Episodes that start at each free frame with probability `rate` and last a geometric number of
+// frames with mean `mean_frames`: the episode's number (0, 1, ...) for each of its frames, -1
+// elsewhere. Frames already in `busy` (>= 0) neither start nor extend an episode.
+std::vector<int> DrawEpisodes(int frames, double rate, double mean_frames,
+                              const std::vector<int>& busy, std::uint64_t seed) {
+  std::vector<int> episode(frames, -1);
   sim::Random random(seed);
   const double stop = 1.0 / mean_frames;
+  int count = 0;
   for (int t = 0; t < frames; ++t) {
-    if (busy[t] || !random.Bernoulli(rate)) continue;
+    if (busy[t] >= 0 || !random.Bernoulli(rate)) continue;
     // Length k >= 1 with P(k) = (1 - stop)^(k - 1) stop.
     int k = 1;
     while (!random.Bernoulli(stop)) ++k;
-    for (int u = t; u < std::min(frames, t + k) && !busy[u]; ++u) in_episode[u] = true;
+    for (int u = t; u < std::min(frames, t + k) && busy[u] < 0; ++u) episode[u] = count;
+    ++count;
     t += k - 1;
   }
-  return in_episode;
+  return episode;
+}
+
+// Frames in either set of episodes (>= 0 in one of them).
+std::vector<int> Union(const std::vector<int>& a, const std::vector<int>& b) {
+  std::vector<int> out(a.size());
+  for (std::size_t t = 0; t < a.size(); ++t) out[t] = std::max(a[t], b[t]);
+  return out;
+}
+
+Eigen::Quaterniond ExpRotation(const Eigen::Vector3d& r) {
+  const double angle = r.norm();
+  return angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle))
+                   : Eigen::Quaterniond::Identity();
 }
 
 // The error of `tracked` against `truth` in the proxy frame: rotation vector and translation.
@@ -96,13 +119,18 @@ void ErrorModelOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(translation_sd, prefix + ".translation_sd", "m");
   RequireNonNegative(rotation_sd, prefix + ".rotation_sd", "rad");
   RequireCorrelation(correlation, prefix + ".correlation");
-  RequireProbability(gross_rate, prefix + ".gross_rate");
-  RequireEpisodeLength(gross_mean_frames, prefix + ".gross_mean_frames");
-  RequireFinite(gross_rotation, prefix + ".gross_rotation");
-  if (gross_rotation < 0 || gross_rotation > kPi) {
-    ThrowBadValue(prefix + ".gross_rotation", FormatNumber(gross_rotation),
+  RequireProbability(flip_rate, prefix + ".flip_rate");
+  RequireEpisodeLength(flip_mean_frames, prefix + ".flip_mean_frames");
+  RequireFinite(flip_rotation, prefix + ".flip_rotation");
+  if (flip_rotation < 0 || flip_rotation > kPi) {
+    ThrowBadValue(prefix + ".flip_rotation", FormatNumber(flip_rotation),
                   "an angle in [0, pi] rad");
   }
+  RequireNonNegative(flip_translation, prefix + ".flip_translation", "m");
+  RequireProbability(spike_rate, prefix + ".spike_rate");
+  RequireEpisodeLength(spike_mean_frames, prefix + ".spike_mean_frames");
+  RequireNonNegative(spike_rotation_sd, prefix + ".spike_rotation_sd", "rad");
+  RequireNonNegative(spike_translation_sd, prefix + ".spike_translation_sd", "m");
   RequireProbability(loss_rate, prefix + ".loss_rate");
   RequireEpisodeLength(loss_mean_frames, prefix + ".loss_mean_frames");
   RequireNonNegative(slider_sd, prefix + ".slider_sd", "slider units");
@@ -128,12 +156,14 @@ SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOpti
   out.tracked.poses.resize(frames);
   out.status.assign(frames, track::TrackStatus::kTracked);
 
-  const std::vector<bool> none(frames, false);
-  const std::vector<bool> lost = DrawEpisodes(frames, options.loss_rate, options.loss_mean_frames,
-                                              none, sim::DeriveSeed(seed, {kLossStream}));
-  const std::vector<bool> gross =
-      DrawEpisodes(frames, options.gross_rate, options.gross_mean_frames, lost,
-                   sim::DeriveSeed(seed, {kGrossStream}));
+  const std::vector<int> none(frames, -1);
+  const std::vector<int> lost = DrawEpisodes(frames, options.loss_rate, options.loss_mean_frames,
+                                             none, sim::DeriveSeed(seed, {kLossStream}));
+  const std::vector<int> flip = DrawEpisodes(frames, options.flip_rate, options.flip_mean_frames,
+                                             lost, sim::DeriveSeed(seed, {kFlipStream}));
+  const std::vector<int> spike =
+      DrawEpisodes(frames, options.spike_rate, options.spike_mean_frames, Union(lost, flip),
+                   sim::DeriveSeed(seed, {kSpikeStream}));
 
   sim::Random random(sim::DeriveSeed(seed, {kPoseStream}));
   std::array<Ar1, 6> axes = {Ar1(options.rotation_sd, options.correlation),
@@ -142,28 +172,46 @@ SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOpti
                              Ar1(options.translation_sd, options.correlation),
                              Ar1(options.translation_sd, options.correlation),
                              Ar1(options.translation_sd, options.correlation)};
-  const Eigen::Quaterniond twin(
-      Eigen::AngleAxisd(options.gross_rotation, Eigen::Vector3d::UnitZ()));
+  const Eigen::Quaterniond twin(Eigen::AngleAxisd(options.flip_rotation, Eigen::Vector3d::UnitZ()));
+  // Each episode's shape: a flip's horizontal offset direction, a spike's error.
+  sim::Random flip_shape(sim::DeriveSeed(seed, {kFlipShapeStream}));
+  sim::Random spike_shape(sim::DeriveSeed(seed, {kSpikeShapeStream}));
+  int flip_episode = -1, spike_episode = -1;
+  Eigen::Vector3d flip_offset = Eigen::Vector3d::Zero();
+  Eigen::Vector3d spike_r = Eigen::Vector3d::Zero(), spike_e = Eigen::Vector3d::Zero();
   for (int t = 0; t < frames; ++t) {
-    // The error processes run on through losses (the tracker's bias drifts with the view either
-    // way), so the draws of a frame do not depend on the episodes.
+    // The error processes run on through the episodes (the tracker's bias drifts with the view
+    // either way), so the draws of a frame do not depend on them.
     std::array<double, 6> x;
     for (int k = 0; k < 6; ++k) x[k] = axes[k].Next(random);
-    if (lost[t]) {
+    if (lost[t] >= 0) {
       out.status[t] = track::TrackStatus::kLost;
       out.tracked.poses[t] = t > 0 ? out.tracked.poses[t - 1] : truth.poses[t];
       continue;
     }
-    const Eigen::Vector3d r(x[0], x[1], x[2]);
-    const double angle = r.norm();
-    const Eigen::Quaterniond proxy_q_error =
-        angle > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(angle, r / angle))
-                  : Eigen::Quaterniond::Identity();
-    const Rigid3 proxy_T_error(proxy_q_error, Eigen::Vector3d(x[3], x[4], x[5]));
-    Rigid3 table_T_tracked = truth.poses[t] * proxy_T_error;
-    if (gross[t]) {
-      // The near-symmetric twin: turned about the table's vertical through the proxy's origin.
+    Eigen::Vector3d r(x[0], x[1], x[2]), e(x[3], x[4], x[5]);
+    if (spike[t] >= 0) {
+      if (spike[t] != spike_episode) {
+        spike_episode = spike[t];
+        for (int k = 0; k < 3; ++k) spike_r[k] = spike_shape.Normal(0, options.spike_rotation_sd);
+        for (int k = 0; k < 3; ++k) {
+          spike_e[k] = spike_shape.Normal(0, options.spike_translation_sd);
+        }
+      }
+      r += spike_r;
+      e += spike_e;
+    }
+    Rigid3 table_T_tracked = truth.poses[t] * Rigid3(ExpRotation(r), e);
+    if (flip[t] >= 0) {
+      if (flip[t] != flip_episode) {
+        flip_episode = flip[t];
+        const double heading = flip_shape.Uniform(0, 2 * kPi);
+        flip_offset =
+            options.flip_translation * Eigen::Vector3d(std::cos(heading), std::sin(heading), 0.0);
+      }
+      // The near-symmetric twin: turned about the table's vertical, off by the offset.
       table_T_tracked.rotation = (twin * table_T_tracked.rotation).normalized();
+      table_T_tracked.translation += flip_offset;
     }
     out.tracked.poses[t] = table_T_tracked;
   }
@@ -210,9 +258,11 @@ nlohmann::json ErrorModelEstimate::ToJson() const {
   return {{"options", j},
           {"frames", frames},
           {"inlier_frames", inlier_frames},
-          {"gross_frames", gross_frames},
+          {"flip_frames", flip_frames},
+          {"spike_frames", spike_frames},
           {"lost_frames", lost_frames},
-          {"gross_episodes", gross_episodes},
+          {"flip_episodes", flip_episodes},
+          {"spike_episodes", spike_episodes},
           {"loss_episodes", loss_episodes},
           {"slider_frames", slider_frames},
           {"slider_missed", slider_missed},
@@ -230,7 +280,10 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
   // Pose errors: per type (0 rotation, 1 translation) the sum of squares over inlier frames, and
   // over consecutive inlier pairs the lag-one products and the mean squares of the pair.
   std::array<double, 2> squares = {0, 0}, lag_products = {0, 0}, lag_squares = {0, 0};
-  Runs gross_runs, loss_runs;
+  Runs flip_runs, spike_runs, loss_runs;
+  // Flip frames: sums of the error angle and distance; spike frames: squares per type.
+  double flip_angle_sum = 0, flip_distance_sum = 0;
+  std::array<double, 2> spike_squares = {0, 0};
   for (std::size_t i = 0; i < tracking.size(); ++i) {
     const auto& obs = tracking[i];
     const std::string name = "tracking observation " + std::to_string(i);
@@ -242,15 +295,24 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
                        std::to_string(obs.status->size()) + ")");
     }
     std::vector<std::array<double, 6>> errors(n);
-    std::vector<bool> lost(n), gross(n), inlier(n);
+    std::vector<bool> lost(n), flip(n), spike(n), inlier(n), lost_or_flip(n);
     for (std::size_t t = 0; t < n; ++t) {
       lost[t] = (*obs.status)[t] == track::TrackStatus::kLost;
       if (lost[t]) continue;
       errors[t] = PoseError(obs.truth->poses[t], obs.tracked->poses[t]);
       const double angle = std::hypot(errors[t][0], errors[t][1], errors[t][2]);
       const double distance = std::hypot(errors[t][3], errors[t][4], errors[t][5]);
-      gross[t] = angle > gross_threshold_rad || distance > gross_threshold_m;
-      inlier[t] = !gross[t];
+      const bool gross = angle > gross_threshold_rad || distance > gross_threshold_m;
+      flip[t] = gross && angle > kPi / 2;
+      spike[t] = gross && !flip[t];
+      inlier[t] = !gross;
+      if (flip[t]) {
+        flip_angle_sum += angle;
+        flip_distance_sum += distance;
+      }
+      if (spike[t]) {
+        for (int k = 0; k < 6; ++k) spike_squares[k / 3] += errors[t][k] * errors[t][k];
+      }
       if (!inlier[t]) continue;
       ++estimate.inlier_frames;
       for (int k = 0; k < 6; ++k) squares[k / 3] += errors[t][k] * errors[t][k];
@@ -265,12 +327,16 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
     }
     estimate.frames += static_cast<std::int64_t>(n);
     CountRuns(lost, std::vector<bool>(n, false), &loss_runs);
-    CountRuns(gross, lost, &gross_runs);
+    for (std::size_t t = 0; t < n; ++t) lost_or_flip[t] = lost[t] || flip[t];
+    CountRuns(flip, lost, &flip_runs);
+    CountRuns(spike, lost_or_flip, &spike_runs);
   }
   estimate.lost_frames = loss_runs.frames;
-  estimate.gross_frames = gross_runs.frames;
+  estimate.flip_frames = flip_runs.frames;
+  estimate.spike_frames = spike_runs.frames;
   estimate.loss_episodes = loss_runs.runs;
-  estimate.gross_episodes = gross_runs.runs;
+  estimate.flip_episodes = flip_runs.runs;
+  estimate.spike_episodes = spike_runs.runs;
   ErrorModelOptions& fit = estimate.options;
   if (estimate.inlier_frames > 0) {
     const double axes = 3.0 * static_cast<double>(estimate.inlier_frames);
@@ -292,11 +358,22 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
   if (loss_runs.runs > 0) {
     fit.loss_mean_frames = static_cast<double>(loss_runs.frames) / loss_runs.runs;
   }
-  if (gross_runs.at_risk > 0) {
-    fit.gross_rate = static_cast<double>(gross_runs.runs) / static_cast<double>(gross_runs.at_risk);
+  const auto rate = [](const Runs& runs) {
+    return static_cast<double>(runs.runs) / static_cast<double>(runs.at_risk);
+  };
+  if (flip_runs.at_risk > 0) fit.flip_rate = rate(flip_runs);
+  if (spike_runs.at_risk > 0) fit.spike_rate = rate(spike_runs);
+  if (flip_runs.runs > 0) {
+    const double frames = static_cast<double>(flip_runs.frames);
+    fit.flip_mean_frames = frames / flip_runs.runs;
+    fit.flip_rotation = flip_angle_sum / frames;
+    fit.flip_translation = flip_distance_sum / frames;
   }
-  if (gross_runs.runs > 0) {
-    fit.gross_mean_frames = static_cast<double>(gross_runs.frames) / gross_runs.runs;
+  if (spike_runs.runs > 0) {
+    const double frames = static_cast<double>(spike_runs.frames);
+    fit.spike_mean_frames = frames / spike_runs.runs;
+    fit.spike_rotation_sd = std::sqrt(spike_squares[0] / (3 * frames));
+    fit.spike_translation_sd = std::sqrt(spike_squares[1] / (3 * frames));
   }
 
   // Slider readings over found frames.

@@ -8,10 +8,16 @@
 // (Exp(r_t), e_t) with r_t (rotation vector [rad]) and e_t (translation [m]) in the proxy frame,
 // each of the six components an independent stationary AR(1) process
 //   x_{t+1} = ρ x_t + sqrt(1 − ρ²) σ n_t,  n_t ~ N(0, 1),  x_0 ~ N(0, σ²),
-// so that Var x_t = σ² and Corr(x_t, x_{t+1}) = ρ. On top of that, gross-error episodes (the
-// tracker locked onto the proxy's near-symmetric twin: a half turn about the table's vertical)
-// and loss episodes, each starting at a frame with its rate and lasting a geometric number of
-// frames with its mean (P(k) = (1 − 1/L)^(k−1) / L, k ≥ 1).
+// so that Var x_t = σ² and Corr(x_t, x_{t+1}) = ρ. On top of that, three kinds of episode, each
+// starting at a free frame with its rate and lasting a geometric number of frames with its mean
+// (P(k) = (1 − 1/L)^(k−1) / L, k ≥ 1), drawn in this order on the frames the earlier kinds left:
+//   losses  the frames are reported lost (the last reported pose held);
+//   flips   the tracker holds the proxy's near-symmetric twin: the pose turned by flip_rotation
+//           about the table's vertical and moved by flip_translation in a horizontal direction
+//           (both fixed per episode; the Soldier lying on its back, tracked upside down);
+//   spikes  a short wrong fit: an error rotation vector and translation drawn per episode
+//           (N(0, spike_rotation_sd²) and N(0, spike_translation_sd²) per axis, proxy frame),
+//           added to the AR(1) error.
 //
 // Slider reading: read_t = clamp(truth_t + bias + s_t, −5, 5), s_t an AR(1) process like the
 // above (sd slider_sd, lag-one correlation slider_correlation); a frame is not found with
@@ -33,32 +39,42 @@ namespace mmh::pipeline {
 struct ErrorModelOptions {
   // Pose errors (see above), per axis in the proxy frame. Defaults: measured on full-fidelity
   // Soldier runs (docs/study.md, "Fidelity"), frames within the tracker's success criterion.
-  double translation_sd = 0.0005;  // σ_e [m]
-  double rotation_sd = 0.0075;     // σ_r [rad]
-  double correlation = 0.8;        // ρ, lag one, in [0, 1)
-  // Gross errors: episodes per frame (at frames not already in an episode), their mean length
-  // [frames], and the rotation error they carry [rad] about the table's vertical (π: the twin).
-  double gross_rate = 0.0005;
-  double gross_mean_frames = 5.0;
-  double gross_rotation = 3.14159265358979323846;
+  double translation_sd = 0.00113;  // σ_e [m]
+  double rotation_sd = 0.0181;      // σ_r [rad]
+  double correlation = 0.47;        // ρ, lag one, in [0, 1)
+  // Flips (see above): episodes per frame, mean length [frames], rotation [rad], translation [m].
+  double flip_rate = 0.00047;
+  double flip_mean_frames = 190.0;
+  double flip_rotation = 3.14159265358979323846;
+  double flip_translation = 0.08;
+  // Spikes (see above): episodes per frame, mean length [frames], per-axis sizes [rad], [m].
+  double spike_rate = 0.026;
+  double spike_mean_frames = 1.3;
+  double spike_rotation_sd = 0.08;
+  double spike_translation_sd = 0.004;
   // Losses: episodes per frame, mean length [frames]; their frames are reported lost.
-  double loss_rate = 0.001;
-  double loss_mean_frames = 4.0;
+  double loss_rate = 0.00093;
+  double loss_mean_frames = 1.44;
   // Slider reading: AR(1) noise [slider units] with its lag-one correlation, a bias, and the share
   // of frames in which the block is not found.
-  double slider_sd = 0.12;
-  double slider_correlation = 0.5;
-  double slider_bias = 0.0;
-  double slider_miss_share = 0.002;
+  double slider_sd = 0.163;
+  double slider_correlation = 0.008;
+  double slider_bias = 0.067;
+  double slider_miss_share = 0.0;
 
   template <class V>
   void VisitFields(V& v) {
     v("translation_sd", translation_sd);
     v("rotation_sd", rotation_sd);
     v("correlation", correlation);
-    v("gross_rate", gross_rate);
-    v("gross_mean_frames", gross_mean_frames);
-    v("gross_rotation", gross_rotation);
+    v("flip_rate", flip_rate);
+    v("flip_mean_frames", flip_mean_frames);
+    v("flip_rotation", flip_rotation);
+    v("flip_translation", flip_translation);
+    v("spike_rate", spike_rate);
+    v("spike_mean_frames", spike_mean_frames);
+    v("spike_rotation_sd", spike_rotation_sd);
+    v("spike_translation_sd", spike_translation_sd);
     v("loss_rate", loss_rate);
     v("loss_mean_frames", loss_mean_frames);
     v("slider_sd", slider_sd);
@@ -107,9 +123,11 @@ struct ErrorModelEstimate {
   ErrorModelOptions options;  // the fitted model (fields without data keep `prior`'s values)
   std::int64_t frames = 0;    // tracked frames observed
   std::int64_t inlier_frames = 0;
-  std::int64_t gross_frames = 0;
+  std::int64_t flip_frames = 0;
+  std::int64_t spike_frames = 0;
   std::int64_t lost_frames = 0;
-  int gross_episodes = 0;
+  int flip_episodes = 0;
+  int spike_episodes = 0;
   int loss_episodes = 0;
   std::int64_t slider_frames = 0;
   std::int64_t slider_missed = 0;
@@ -118,12 +136,15 @@ struct ErrorModelEstimate {
   nlohmann::json ToJson() const;
 };
 
-// Fits the model by moments: σ as the per-axis RMS and ρ as the pooled lag-one autocorrelation of
-// the error components over consecutive inlier frames (within gross_threshold_deg and
-// gross_threshold_m, the tracker's success criterion); gross and loss episodes as runs of
-// consecutive frames beyond the threshold or lost, rate = episodes / frames at risk, mean = frames
-// / episodes; the slider's bias, sd and lag-one correlation over found frames, miss share =
-// missed / frames. The maximum-likelihood estimates of the model for a large sample.
+// Fits the model by moments. Frames within gross_threshold_deg and gross_threshold_m (the
+// tracker's success criterion) are inliers: σ is the per-axis RMS and ρ the pooled lag-one
+// autocorrelation of their error components over consecutive inlier frames. Frames beyond it with
+// a rotation error above 90° are flips, the others spikes; flip, spike and loss episodes are runs
+// of consecutive such frames: rate = episodes / frames at risk (the frames not in an episode of
+// that kind or an earlier one), mean = frames / episodes; flip_rotation and flip_translation are
+// the mean error angle and distance over flip frames, the spike sizes the per-axis RMS over spike
+// frames. The slider's bias, sd and lag-one correlation over found frames, miss share = missed /
+// frames. The maximum-likelihood estimates of the model for a large sample.
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
                                       const std::vector<ReadingObservation>& readings,
                                       const ErrorModelOptions& prior = {},

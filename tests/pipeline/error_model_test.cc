@@ -52,7 +52,8 @@ TEST(ErrorModelTest, PoseErrorsHaveTheModelsSdAndCorrelation) {
   options.rotation_sd = 0.01;
   options.correlation = 0.8;
   options.loss_rate = 0;
-  options.gross_rate = 0;
+  options.flip_rate = 0;
+  options.spike_rate = 0;
   const int frames = 40000;
   const Trajectory truth = Walk(frames);
   const SimulatedTracking sim = SimulateTracking(truth, options, 7);
@@ -81,54 +82,100 @@ TEST(ErrorModelTest, PoseErrorsHaveTheModelsSdAndCorrelation) {
   EXPECT_NEAR(lag / lag_sq, options.correlation, 4 * std::sqrt((1 - 0.64) / (6.0 * frames)));
 }
 
-TEST(ErrorModelTest, LossAndGrossEpisodesHaveTheModelsRateAndLength) {
+// Runs of frames where `flag` holds: (runs, frames in them, frames at risk = not flagged and not
+// excluded).
+struct RunCount {
+  int runs = 0, frames = 0, at_risk = 0;
+};
+RunCount CountRuns(const std::vector<bool>& flag, const std::vector<bool>& excluded) {
+  RunCount c;
+  for (std::size_t t = 0; t < flag.size(); ++t) {
+    if (flag[t]) {
+      ++c.frames;
+      if (t == 0 || !flag[t - 1]) ++c.runs;
+    } else if (!excluded[t]) {
+      ++c.at_risk;
+    }
+  }
+  return c;
+}
+
+// Episode rates are near Poisson (relative standard error 1/sqrt(count)); geometric lengths have
+// sd sqrt(1 - p)/p with p = 1/mean (episodes cut short by the next kind's frames bias the mean down
+// a little: `slack`).
+void ExpectEpisodes(const RunCount& c, double rate, double mean_frames, double slack,
+                    const std::string& what) {
+  ASSERT_GT(c.runs, 20) << what;
+  EXPECT_NEAR(double(c.runs) / c.at_risk, rate, 4 * rate / std::sqrt(c.runs)) << what;
+  const double sd = std::sqrt(1 - 1 / mean_frames) * mean_frames;
+  EXPECT_NEAR(double(c.frames) / c.runs, mean_frames, 4 * sd / std::sqrt(c.runs) + slack) << what;
+}
+
+TEST(ErrorModelTest, EpisodesHaveTheModelsRatesLengthsAndSizes) {
   ErrorModelOptions options;
+  options.rotation_sd = 0.0075;
+  options.translation_sd = 0.0005;
   options.loss_rate = 0.01;
   options.loss_mean_frames = 4;
-  options.gross_rate = 0.005;
-  options.gross_mean_frames = 6;
-  const int frames = 100000;
+  options.flip_rate = 0.002;
+  options.flip_mean_frames = 20;
+  options.flip_translation = 0.05;
+  options.spike_rate = 0.01;
+  options.spike_mean_frames = 2;
+  options.spike_rotation_sd = 0.3;
+  options.spike_translation_sd = 0.01;
+  const int frames = 200000;
   const Trajectory truth = Walk(frames);
   const SimulatedTracking sim = SimulateTracking(truth, options, 11);
-  int loss_runs = 0, lost = 0, gross_runs = 0, gross = 0, loss_at_risk = 0, gross_at_risk = 0;
-  bool previous_gross = false;
+  std::vector<bool> lost(frames), flip(frames), spike(frames), lost_or_flip(frames);
+  double flip_angle = 0, flip_distance = 0;
+  std::vector<std::array<double, 6>> spike_errors;  // one per spike episode (its first frame)
   for (int t = 0; t < frames; ++t) {
-    const bool is_lost = sim.status[t] == track::TrackStatus::kLost;
-    if (is_lost) {
-      ++lost;
-      if (t == 0 || sim.status[t - 1] != track::TrackStatus::kLost) ++loss_runs;
+    lost[t] = sim.status[t] == track::TrackStatus::kLost;
+    if (lost[t]) {
       EXPECT_TRUE(t == 0 ||
                   sim.tracked.poses[t].translation == sim.tracked.poses[t - 1].translation)
           << "a lost frame holds the last pose";
-      previous_gross = false;
+      lost_or_flip[t] = true;
       continue;
     }
-    ++loss_at_risk;
     const auto e = Error(truth.poses[t], sim.tracked.poses[t]);
     const double angle = std::hypot(e[0], e[1], e[2]);
-    const bool is_gross = angle > 0.5;
-    if (is_gross) {
-      EXPECT_NEAR(angle, kPi, 0.1);
-      ++gross;
-      if (!previous_gross) ++gross_runs;
-    } else {
-      ++gross_at_risk;
+    const double distance = std::hypot(e[3], e[4], e[5]);
+    flip[t] = angle > kPi / 2;
+    // The core noise (0.0075 rad, 0.5 mm per axis) stays below 0.06 rad and 5 mm.
+    spike[t] = !flip[t] && (angle > 0.06 || distance > 0.005);
+    lost_or_flip[t] = flip[t];
+    if (flip[t]) {
+      flip_angle += angle;
+      flip_distance += distance;
     }
-    previous_gross = is_gross;
+    if (spike[t] && (t == 0 || !spike[t - 1])) spike_errors.push_back(e);
   }
-  // Episode counts are near Poisson: relative standard error 1/sqrt(count).
-  const double loss_rate = double(loss_runs) / loss_at_risk;
-  EXPECT_NEAR(loss_rate, options.loss_rate, 4 * options.loss_rate / std::sqrt(loss_runs));
-  // Geometric lengths: sd sqrt(1 − p)/p with p = 1/mean (runs that touch cut little).
-  const double loss_sd = std::sqrt(1 - 1 / options.loss_mean_frames) * options.loss_mean_frames;
-  EXPECT_NEAR(double(lost) / loss_runs, options.loss_mean_frames,
-              4 * loss_sd / std::sqrt(loss_runs) + 0.1);
-  const double gross_rate = double(gross_runs) / gross_at_risk;
-  EXPECT_NEAR(gross_rate, options.gross_rate, 4 * options.gross_rate / std::sqrt(gross_runs));
-  // Gross episodes are cut short by losses that follow them, so their mean length is a little
-  // below the option's; and above 1.
-  EXPECT_GT(double(gross) / gross_runs, 0.8 * options.gross_mean_frames);
-  EXPECT_LT(double(gross) / gross_runs, options.gross_mean_frames + 0.5);
+  ExpectEpisodes(CountRuns(lost, std::vector<bool>(frames, false)), options.loss_rate,
+                 options.loss_mean_frames, 0.0, "losses");
+  const RunCount flips = CountRuns(flip, lost);
+  ExpectEpisodes(flips, options.flip_rate, options.flip_mean_frames, 1.0, "flips");
+  ExpectEpisodes(CountRuns(spike, lost_or_flip), options.spike_rate, options.spike_mean_frames, 0.1,
+                 "spikes");
+  // A flip turns the pose by pi (less the core noise) and moves it by flip_translation
+  // horizontally (the core noise adds in quadrature).
+  EXPECT_NEAR(flip_angle / flips.frames, options.flip_rotation, 0.03);
+  EXPECT_NEAR(flip_distance / flips.frames, options.flip_translation, 0.002);
+  // Spike sizes: per-axis RMS over episodes; chi-squared with 3 per episode, relative se of the RMS
+  // 1/sqrt(6 episodes).
+  double r2 = 0, e2 = 0;
+  for (const auto& e : spike_errors) {
+    for (int k = 0; k < 3; ++k) r2 += e[k] * e[k];
+    for (int k = 3; k < 6; ++k) e2 += e[k] * e[k];
+  }
+  const double n = 3.0 * spike_errors.size();
+  const double relative = 4 / std::sqrt(2 * n);
+  // (The rotation vector of a large spike is the spike's own: its angle is below pi for these
+  // sizes; wrapped ones are rare.)
+  EXPECT_NEAR(std::sqrt(r2 / n), options.spike_rotation_sd, relative * options.spike_rotation_sd);
+  EXPECT_NEAR(std::sqrt(e2 / n), options.spike_translation_sd,
+              relative * options.spike_translation_sd + 0.0005);
 }
 
 TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
@@ -138,8 +185,13 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   options.correlation = 0.7;
   options.loss_rate = 0.004;
   options.loss_mean_frames = 3;
-  options.gross_rate = 0.002;
-  options.gross_mean_frames = 4;
+  options.flip_rate = 0.0005;
+  options.flip_mean_frames = 50;
+  options.flip_translation = 0.06;
+  options.spike_rate = 0.005;
+  options.spike_mean_frames = 1.5;
+  options.spike_rotation_sd = 0.4;
+  options.spike_translation_sd = 0.02;
   options.slider_sd = 0.15;
   options.slider_correlation = 0.6;
   options.slider_bias = 0.05;
@@ -175,8 +227,16 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   EXPECT_NEAR(fit.loss_rate, options.loss_rate,
               4 * options.loss_rate / std::sqrt(estimate.loss_episodes));
   EXPECT_NEAR(fit.loss_mean_frames, options.loss_mean_frames, 0.3);
-  EXPECT_NEAR(fit.gross_rate, options.gross_rate,
-              4 * options.gross_rate / std::sqrt(estimate.gross_episodes));
+  EXPECT_NEAR(fit.flip_rate, options.flip_rate,
+              4 * options.flip_rate / std::sqrt(estimate.flip_episodes));
+  EXPECT_NEAR(fit.flip_mean_frames, options.flip_mean_frames,
+              4 * options.flip_mean_frames / std::sqrt(estimate.flip_episodes) + 1);
+  EXPECT_NEAR(fit.flip_rotation, options.flip_rotation, 0.03);
+  EXPECT_NEAR(fit.flip_translation, options.flip_translation, 0.003);
+  // Spikes within the success criterion (5 deg, 1 cm) count as inliers: with these sizes few are.
+  EXPECT_NEAR(fit.spike_rate, options.spike_rate,
+              4 * options.spike_rate / std::sqrt(estimate.spike_episodes) + 0.0005);
+  EXPECT_NEAR(fit.spike_rotation_sd, options.spike_rotation_sd, 0.1 * options.spike_rotation_sd);
   const double slider_n = double(estimate.slider_frames - estimate.slider_missed);
   const double slider_rel = SdRelativeError(slider_n, options.slider_correlation);
   EXPECT_NEAR(fit.slider_sd, options.slider_sd, 4 * slider_rel * options.slider_sd);

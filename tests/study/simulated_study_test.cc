@@ -25,6 +25,8 @@ Config SmallConfig(int animators, const std::string& fidelity = "fast") {
   config.Set("run.practice=" + kSource + "/configs/stories/mario.json");
   config.Set("run.fidelity=" + fidelity);
   config.Set("study.animators=" + std::to_string(animators));
+  // 20 s of each take: the whole protocol, a third of the frames.
+  config.Set("render.frames=600");
   return config;
 }
 
