@@ -59,6 +59,25 @@ TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
   EXPECT_NE(RunAnimator(config, 3).metrics.dump(), a.metrics.dump());
 }
 
+// The paper's protocol starts with a Mario practice: recorded and tracked, not composited; the
+// takes' skill index starts after it.
+TEST(AnimatorRunTest, APracticeTakeComesFirstAndIsNotComposited) {
+  Config config;
+  config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  config.Set(std::string("run.practice=\"") + MMH_SOURCE_DIR + "/configs/stories/mario.json\"");
+  config.Set("run.fidelity=fast");
+  const AnimatorRun run = RunAnimator(RunConfig::FromConfig(config), 4);
+  ASSERT_TRUE(run.practice.has_value());
+  EXPECT_EQ(run.practice->take, 0);
+  EXPECT_TRUE(run.practice->read_annotation.values.empty());
+  ASSERT_EQ(run.takes.size(), 3u);
+  EXPECT_EQ(run.takes[0].take, 1);
+  EXPECT_GT(run.takes[0].performed.skill, run.practice->performed.skill);
+  EXPECT_EQ(run.montage.summary.takes, 3);
+  EXPECT_TRUE(run.metrics.contains("practice"));
+  EXPECT_GT(run.metrics["practice"]["tracking"]["frames"].get<int>(), 100);
+}
+
 // The full pipeline on the first 75 frames of two takes: rendered, tracked and read, with the
 // same results for one thread as for two.
 TEST(AnimatorRunTest, FullFidelityTracksReadsAndDoesNotDependOnThreads) {
