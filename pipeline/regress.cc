@@ -8,32 +8,17 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/options.h"
 #include "pipeline/run_metrics.h"
 
 namespace mmh::pipeline {
 
 namespace {
 
-Better ParseBetter(const nlohmann::json& j, const std::string& where) {
-  if (!j.is_string()) ThrowBadValue(where, j.dump(), "\"higher\", \"lower\" or \"either\"");
-  const std::string s = j.get<std::string>();
-  if (s == "higher") return Better::kHigher;
-  if (s == "lower") return Better::kLower;
-  if (s == "either") return Better::kEither;
-  ThrowBadValue(where, "\"" + s + "\"", "\"higher\", \"lower\" or \"either\"");
-}
+constexpr std::pair<Better, const char*> kBetterNames[] = {
+    {Better::kHigher, "higher"}, {Better::kLower, "lower"}, {Better::kEither, "either"}};
 
-const char* BetterName(Better better) {
-  switch (better) {
-    case Better::kHigher:
-      return "higher";
-    case Better::kLower:
-      return "lower";
-    case Better::kEither:
-      return "either";
-  }
-  return "either";
-}
+const char* BetterName(Better better) { return EnumName(better); }
 
 const nlohmann::json& Require(const nlohmann::json& object, const std::string& key,
                               const std::string& where) {
@@ -53,14 +38,14 @@ void RequireOnlyKeys(const nlohmann::json& object, const std::vector<std::string
   }
 }
 
-double RequireNumber(const nlohmann::json& j, const std::string& where) {
-  if (!j.is_number()) ThrowBadValue(where, j.dump(), "a number");
-  const double v = j.get<double>();
-  RequireFinite(v, where);
-  return v;
-}
-
 }  // namespace
+
+std::span<const std::pair<Better, const char*>> EnumNames(Better) { return kBetterNames; }
+
+void MetricTolerance::Validate(const std::string& prefix) const {
+  RequireFinite(value, prefix + ".value");
+  RequireNonNegative(tolerance, prefix + ".tolerance");
+}
 
 Baseline ReadBaseline(const std::filesystem::path& folder) {
   Baseline b;
@@ -111,19 +96,9 @@ Baseline ReadBaseline(const std::filesystem::path& folder) {
       ThrowBadValue(where + ".metrics", metrics.dump().substr(0, 40), "an object");
     }
     for (const auto& [key, m] : metrics.items()) {
-      const std::string mw = where + ".metrics." + key;
-      if (!m.is_object()) ThrowBadValue(mw, m.dump(), "an object {value, tolerance, ...}");
-      RequireOnlyKeys(m, {"value", "tolerance", "relative", "better"}, mw);
       MetricTolerance t;
-      t.value = RequireNumber(Require(m, "value", mw), mw + ".value");
-      t.tolerance = RequireNumber(Require(m, "tolerance", mw), mw + ".tolerance");
-      RequireNonNegative(t.tolerance, mw + ".tolerance");
-      if (m.contains("relative")) {
-        if (!m["relative"].is_boolean())
-          ThrowBadValue(mw + ".relative", m["relative"].dump(), "true or false");
-        t.relative = m["relative"].get<bool>();
-      }
-      if (m.contains("better")) t.better = ParseBetter(m["better"], mw + ".better");
+      FromJson(m, "scenarios[" + std::to_string(i) + "].metrics." + key, ConfigSource{file}, &t);
+      t.Validate(where + ".metrics." + key);
       scenario.metrics.emplace_back(key, t);
     }
     for (const Scenario& other : b.scenarios) {

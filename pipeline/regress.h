@@ -19,18 +19,31 @@
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mmh::pipeline {
 
 enum class Better { kHigher, kLower, kEither };
+std::span<const std::pair<Better, const char*>> EnumNames(Better);
 
+// One metric's baseline entry (read through core/options.h: unknown keys are errors).
 struct MetricTolerance {
   double value = 0.0;
-  double tolerance = 0.0;
+  double tolerance = 0.0;  // >= 0; absolute, or a share of |value| when relative
   bool relative = false;
   Better better = Better::kEither;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("value", value);
+    v("tolerance", tolerance);
+    v("relative", relative);
+    v("better", better);
+  }
+  void Validate(const std::string& prefix) const;
 };
 
 struct Scenario {
