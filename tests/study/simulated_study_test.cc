@@ -180,3 +180,51 @@ TEST(SimulatedStudyTest, BadStudyOptionsAreInputErrors) {
 
 }  // namespace
 }  // namespace mmh::study
+
+namespace mmh::study {
+namespace {
+
+// Fast fidelity against full fidelity on the same small study (same people, same performances,
+// same viewers): 3 animators, 4 s takes, no practice, so that the rendered and tracked version
+// stays short for the suite (about 1600 frames). The tolerances are stated per line.
+TEST(SimulatedStudyTest, FastFidelityAgreesWithFullFidelity) {
+  Config config = SmallConfig(3, "full");
+  config.Set("render.frames=120");
+  config.Set("run.practice=\"\"");
+  const StudyConfig full_config = StudyConfig::FromConfig(config);
+  config.Set("run.fidelity=fast");
+  const StudyConfig fast_config = StudyConfig::FromConfig(config);
+  const SimulatedStudy full = RunSimulatedStudy(full_config);
+  const SimulatedStudy fast = RunSimulatedStudy(fast_config);
+  EXPECT_GT(full.rendered_frames, 3 * 6 * 100);
+  ASSERT_TRUE(full.measured_error_model.has_value());
+
+  // The people do not depend on the fidelity: the same takes, the same latent quality.
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(full.animators[i].take_quality, fast.animators[i].take_quality);
+    EXPECT_EQ(full.data.comparisons.size(), fast.data.comparisons.size());
+  }
+  // The error model's core parameters describe the tracker and the slider reader on these takes
+  // within a factor of 2 (the defaults were measured on whole takes; these are the first 4 s).
+  const pipeline::ErrorModelOptions& measured = full.measured_error_model->options;
+  const pipeline::ErrorModelOptions& model = fast_config.run.error_model;
+  EXPECT_GT(measured.rotation_sd, model.rotation_sd / 2);
+  EXPECT_LT(measured.rotation_sd, model.rotation_sd * 2);
+  EXPECT_GT(measured.translation_sd, model.translation_sd / 2);
+  EXPECT_LT(measured.translation_sd, model.translation_sd * 2);
+  EXPECT_GT(measured.slider_sd, model.slider_sd / 2);
+  EXPECT_LT(measured.slider_sd, model.slider_sd * 2);
+  EXPECT_NEAR(measured.slider_bias, model.slider_bias, 0.15);
+  // Study level: the montages show the same quality of performance within 0.1 (the montage from
+  // tracked data picks by read annotations in both modes), and the montage's share of the
+  // comparisons agrees within 0.25.
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(full.animators[i].montage_appeal.mean_quality,
+                fast.animators[i].montage_appeal.mean_quality, 0.1)
+        << "animator " << i;
+  }
+  EXPECT_NEAR(full.analysis.h1.mean_m, fast.analysis.h1.mean_m, 0.25);
+}
+
+}  // namespace
+}  // namespace mmh::study
