@@ -30,16 +30,29 @@ struct RegressArgs {
   bool update = false;
 };
 
+// The config keys that name files.
+constexpr const char* kPathKeys[][2] = {{"render", "story"},
+                                        {"run", "practice"},
+                                        {"render", "proxy"},
+                                        {"render", "trajectory"},
+                                        {"render", "annotation"}};
+
 // Relative file paths of a scenario's config resolve against the baseline's root, so that
-// `mmh regress` gives the same runs from any working directory.
-void ResolvePaths(pipeline::RunConfig& config, const std::filesystem::path& root) {
-  for (std::string* path :
-       {&config.render.render.story, &config.run.practice, &config.render.render.proxy,
-        &config.render.render.trajectory, &config.render.render.annotation}) {
-    if (!path->empty() && std::filesystem::path(*path).is_relative()) {
-      *path = (root / *path).lexically_normal().string();
-    }
+// `mmh regress` gives the same runs from any working directory. Returns the config's JSON with
+// the paths as written (for the config hash, which must not depend on where the clone is).
+nlohmann::json ResolvePaths(Config& config, const std::filesystem::path& root) {
+  const nlohmann::json as_written = config.root();
+  for (const auto& [section, key] : kPathKeys) {
+    const auto s = config.root().find(section);
+    if (s == config.root().end() || !s->is_object()) continue;
+    const auto v = s->find(key);
+    if (v == s->end() || !v->is_string()) continue;
+    const std::string path = v->get<std::string>();
+    if (path.empty() || std::filesystem::path(path).is_absolute()) continue;
+    config.Set(std::string(section) + "." + key + "=" +
+               nlohmann::json((root / path).lexically_normal().string()).dump());
   }
+  return as_written;
 }
 
 void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
@@ -68,9 +81,16 @@ void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
     }
     Config config = Config::Load(scenario.config);
     for (const std::string& set : scenario.sets) config.Set(set);
+    const nlohmann::json as_written = ResolvePaths(config, baseline.root);
     pipeline::RunConfig run_config = pipeline::RunConfig::FromConfig(config);
-    const std::string hash = ConfigHash(run_config.ToJson());
-    ResolvePaths(run_config, baseline.root);
+    // The hash of the resolved config with the paths as the scenario writes them.
+    nlohmann::json resolved = run_config.ToJson();
+    for (const auto& [section, key] : kPathKeys) {
+      if (as_written.contains(section) && as_written[section].contains(key)) {
+        resolved[section][key] = as_written[section][key];
+      }
+    }
+    const std::string hash = ConfigHash(resolved);
     runs.push_back({&scenario, std::move(run_config), hash});
   }
   const auto threads = LimitThreads(args.common.threads);
