@@ -26,6 +26,8 @@ void IcpOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(min_rotation, prefix + ".min_rotation", "rad");
   RequireNonNegative(min_translation, prefix + ".min_translation", "m");
   RequirePositive(inlier_distance, prefix + ".inlier_distance", "m");
+  RequireNonNegative(prior_rotation_deg, prefix + ".prior_rotation_deg", "deg");
+  RequireNonNegative(prior_translation, prefix + ".prior_translation", "m");
 }
 
 namespace {
@@ -43,15 +45,26 @@ float DistanceAt(const IcpOptions& o, int k) {
 
 IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vector3f> points,
                             size_t scored, double extra_distance, const Rigid3& proxy_T_camera,
-                            const IcpOptions& options) {
+                            const IcpOptions& options, std::span<const uint8_t> sample_matches) {
   IcpResult result;
   Eigen::Matrix3d rotation = proxy_T_camera.rotation.normalized().toRotationMatrix();
   Eigen::Vector3d translation = proxy_T_camera.translation;
+  const Eigen::Matrix3d start_rotation = rotation;
+  const Eigen::Vector3d start_translation = translation;
+  // Prior weights (see IcpOptions::prior_rotation_deg).
+  const double prior_r =
+      options.prior_rotation_deg > 0
+          ? std::pow(options.huber / (options.prior_rotation_deg * M_PI / 180), 2)
+          : 0.0;
+  const double prior_t =
+      options.prior_translation > 0 ? std::pow(options.huber / options.prior_translation, 2) : 0.0;
   const auto& model_points = model.points();
   const auto& model_normals = model.normals();
   const float huber = static_cast<float>(options.huber);
   const float extra = static_cast<float>(extra_distance);
   scored = std::min(scored, points.size());
+  const bool colour = !sample_matches.empty();
+  const uint8_t* matches = sample_matches.data();
   for (int k = 0; k < options.max_iterations; ++k) {
     const float limit = DistanceAt(options, k);
     const Eigen::Matrix3f r = rotation.cast<float>();
@@ -69,6 +82,7 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
       const Eigen::Vector3f s = rp + t;
       const int c = model.Closest(s);
       if (c < 0) continue;
+      if (colour && !(matches[c] & (i < scored ? kMatchesScored : kMatchesExtra))) continue;
       const Eigen::Vector3f& n = model_normals[c];
       if (n.dot(rp) >= 0) continue;  // the model surface faces away from the camera
       const Eigen::Vector3f d = s - model_points[c];
@@ -95,6 +109,20 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
     g += gf.cast<double>();
     result.iterations = k + 1;
     if (used < 6) break;
+    if (prior_r > 0 || prior_t > 0) {
+      // The deviation from the start, log(T T_start^-1) to first order: a left update exp(xi) T
+      // adds xi to it. Cost 1/2 (e + xi)^T W (e + xi): H += W, g += W e.
+      const Eigen::Matrix3d deviation = rotation * start_rotation.transpose();
+      const Eigen::AngleAxisd angle_axis(deviation);
+      const Eigen::Vector3d e_r = angle_axis.angle() * angle_axis.axis();
+      const Eigen::Vector3d e_t = translation - deviation * start_translation;
+      for (int a = 0; a < 3; ++a) {
+        h(a, a) += prior_r;
+        g(a) += prior_r * e_r(a);
+        h(3 + a, 3 + a) += prior_t;
+        g(3 + a) += prior_t * e_t(a);
+      }
+    }
     // A small damping keeps a degenerate view (a single face) from a wild step.
     h.diagonal().array() += 1e-9 * used;
     const Eigen::Matrix<double, 6, 1> xi = -h.ldlt().solve(g);
@@ -124,6 +152,7 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
     const Eigen::Vector3f s = rp + t;
     const int c = model.Closest(s);
     if (c < 0) continue;
+    if (colour && !(matches[c] & (i < scored ? kMatchesScored : kMatchesExtra))) continue;
     const Eigen::Vector3f& n = model_normals[c];
     if (n.dot(rp) >= 0) continue;
     const Eigen::Vector3f d = s - model_points[c];

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <span>
 #include <string>
 
@@ -33,6 +34,13 @@ struct IcpOptions {
   // Fit the extra points (skin-coloured ones) too, where they lie near the model; otherwise they
   // only count in the result's extra_inliers.
   bool fit_extra_points = true;
+  // A Gaussian prior on the pose's deviation from the start pose (a motion model's prediction):
+  // standard deviations of the rotation [deg] and translation [m]; 0: none. Each adds
+  // (huber / sigma)^2 to the normal equations (the data's residuals are about huber), so it holds
+  // only directions the data leaves (nearly) free: the roll of a box seen face-on while the hand
+  // hides its top, which the data alone lets slide into poses the camera sees through.
+  double prior_rotation_deg = 0.0;
+  double prior_translation = 0.0;
 
   template <class V>
   void VisitFields(V& v) {
@@ -45,6 +53,8 @@ struct IcpOptions {
     v("min_translation", min_translation);
     v("inlier_distance", inlier_distance);
     v("fit_extra_points", fit_extra_points);
+    v("prior_rotation_deg", prior_rotation_deg);
+    v("prior_translation", prior_translation);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -63,11 +73,19 @@ struct IcpResult {
   double rms = 0.0;
 };
 
+// Which data a model sample may match (colour consistency): bit kMatchesScored, the scored points
+// (e.g. not skin-coloured); bit kMatchesExtra, the extra points (skin-coloured).
+inline constexpr uint8_t kMatchesScored = 1, kMatchesExtra = 2;
+
 // Aligns `points` (camera frame [m]) to the model from `proxy_T_camera`. The first `scored`
 // points are the ones the statistics count (the rest, e.g. skin-coloured points, only help the fit
 // where they lie within `extra_distance` of the model; pass points.size() for all).
+// `sample_matches` (#S, empty: every sample matches every point): a point whose closest model
+// sample may not match its kind has no correspondence (a skin-coloured point on the Soldier's blue
+// trousers is the hand in front of them, not the proxy).
 IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vector3f> points,
                             size_t scored, double extra_distance, const Rigid3& proxy_T_camera,
-                            const IcpOptions& options);
+                            const IcpOptions& options,
+                            std::span<const uint8_t> sample_matches = {});
 
 }  // namespace mmh::track

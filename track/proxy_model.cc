@@ -56,6 +56,7 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
       }
       points_.push_back(a + static_cast<float>(s) * (b - a) + static_cast<float>(t) * (c - a));
       normals_.push_back(n);
+      sample_faces_.push_back(f);
     }
   }
   center_ = (0.5 * (bounds.min + bounds.max)).cast<float>();

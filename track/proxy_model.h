@@ -40,6 +40,8 @@ class ProxyModel {
   // #S by 3 sample positions and unit outward normals in the model frame.
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
   const std::vector<Eigen::Vector3f>& normals() const { return normals_; }
+  // #S: the mesh face each sample lies on (for its colour).
+  const std::vector<int>& sample_faces() const { return sample_faces_; }
 
   // Index of the sample nearest to `model_p` (up to half a grid cell), or -1 outside the grid.
   int Closest(const Eigen::Vector3f& model_p) const {
@@ -64,6 +66,7 @@ class ProxyModel {
   ProxyModelOptions options_;
   std::vector<Eigen::Vector3f> points_;
   std::vector<Eigen::Vector3f> normals_;
+  std::vector<int> sample_faces_;
   std::vector<int> sparse_;
   Eigen::Vector3f grid_origin_;
   float inverse_resolution_ = 1;

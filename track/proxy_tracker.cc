@@ -45,6 +45,9 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   }
   RequireNonNegative(switch_margin, prefix + ".switch_margin");
   RequireNonNegative(far_switch_margin, prefix + ".far_switch_margin");
+  if (trusted_frames < 0) {
+    ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
+  }
   RequireProbability(recheck_free_space, prefix + ".recheck_free_space");
   if (coarse_end_distance > coarse_start_distance) {
     ThrowBadValue(prefix + ".coarse_end_distance", FormatNumber(coarse_end_distance),
@@ -62,6 +65,7 @@ void VerificationOptions::Validate(const std::string& prefix) const {
   if (max_predicted_frames < 0) {
     ThrowBadValue(prefix + ".max_predicted_frames", std::to_string(max_predicted_frames), ">= 0");
   }
+  RequireNonNegative(max_penetration, prefix + ".max_penetration", "m");
   RequireNonNegative(skin_distance, prefix + ".skin_distance", "m");
   if (max_points < min_points) {
     ThrowBadValue(prefix + ".max_points", std::to_string(max_points), ">= min_points");
@@ -81,6 +85,7 @@ struct ProxyTracker::Candidate {
   IcpResult icp;
   double free_space_violation = 0.0;
   double explained = 0.0;
+  double penetration = 0.0;
   bool good = false;
   std::string reason;
   // Ranks verified poses: the data the model explains (segmented and skin-coloured points within
@@ -102,6 +107,32 @@ ProxyTracker::ProxyTracker(const TriangleMesh& model, const std::string& model_n
   options_.Validate("tracker");
   setup_.Validate("setup");
   model_ = std::make_unique<ProxyModel>(model, options_.model, model_name);
+  search_icp_ = options_.icp;
+  search_icp_.prior_rotation_deg = 0;
+  search_icp_.prior_translation = 0;
+  // Colour consistency: which samples may match skin-coloured and which other points. A face's
+  // colour is tested with the segmentation's skin box (OpenCV's RGB -> YCrCb, ITU-R BT.601) under
+  // shading from 0.3 to 1.3 times its albedo: a face that is skin-coloured under some shading may
+  // match skin points, one that is not under some shading may match the others (the Soldier's
+  // red tunic is skin-coloured in shadow only; its head, light nougat, is not when brightly lit).
+  const SegmentationOptions& so = options_.segmentation;
+  if (options_.verification.colour_matching && so.skin && model.face_colors.rows() > 0) {
+    std::vector<uint8_t> face_matches(model.face_count(), 0);
+    for (int f = 0; f < model.face_count(); ++f) {
+      for (int shade = 3; shade <= 13; ++shade) {
+        double rgb[3];
+        for (int c = 0; c < 3; ++c)
+          rgb[c] = std::min(255.0, model.face_colors(f, c) * shade / 10.0);
+        const double y = 0.299 * rgb[0] + 0.587 * rgb[1] + 0.114 * rgb[2];
+        const double cr = (rgb[0] - y) * 0.713 + 128, cb = (rgb[2] - y) * 0.564 + 128;
+        const bool skin = cr >= so.skin_cr_min && cr <= so.skin_cr_max && cb >= so.skin_cb_min &&
+                          cb <= so.skin_cb_max;
+        face_matches[f] |= skin ? kMatchesExtra : kMatchesScored;
+      }
+    }
+    sample_matches_.reserve(model_->points().size());
+    for (int f : model_->sample_faces()) sample_matches_.push_back(face_matches[f]);
+  }
 }
 
 ProxyTracker::~ProxyTracker() = default;
@@ -146,9 +177,14 @@ ProxyTracker::Visibility ProxyTracker::ModelVisibility(const RgbdFrame& frame,
   const Eigen::Matrix3f r = camera_T_proxy.rotation.toRotationMatrix().cast<float>();
   const Eigen::Vector3f t = camera_T_proxy.translation.cast<float>();
   const float margin = static_cast<float>(options_.verification.free_space_margin);
+  // The table's up direction and a point on it, camera frame: a sample's height is up . (c - o).
+  const Eigen::Vector3f up = (camera_T_table_->rotation * Eigen::Vector3d::UnitZ()).cast<float>();
+  const float up_offset = up.dot(camera_T_table_->translation.cast<float>());
+  float lowest = 0.0f;
   int seen = 0, violations = 0, explained = 0;
   for (int i : model_->sparse_samples()) {
     const Eigen::Vector3f c = r * model_->points()[i] + t;
+    lowest = std::min(lowest, up.dot(c) - up_offset);
     if (c.z() <= 0.05f || (r * model_->normals()[i]).dot(c) >= 0) continue;
     const int u = static_cast<int>(std::lround(k.fx * c.x() / c.z() + k.cx));
     const int v = static_cast<int>(std::lround(k.fy * c.y() / c.z() + k.cy));
@@ -166,6 +202,7 @@ ProxyTracker::Visibility ProxyTracker::ModelVisibility(const RgbdFrame& frame,
   Visibility visibility;
   visibility.violation = seen > 0 ? static_cast<double>(violations) / seen : 1.0;
   visibility.explained = seen > 0 ? static_cast<double>(explained) / seen : 0.0;
+  visibility.penetration = -lowest;
   return visibility;
 }
 
@@ -177,6 +214,7 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   const Visibility visibility = ModelVisibility(frame, camera_T_proxy);
   candidate.free_space_violation = visibility.violation;
   candidate.explained = visibility.explained;
+  candidate.penetration = visibility.penetration;
   const Eigen::Vector3d table_c =
       camera_T_table_->Inverse() * (camera_T_proxy * model_->center().cast<double>());
   auto text = [](double value) { return FormatNumber(std::round(value * 1e4) / 1e4); };
@@ -188,6 +226,9 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   } else if (candidate.free_space_violation > o.max_free_space_violation) {
     candidate.reason = "free-space violation " + text(candidate.free_space_violation) + " > " +
                        text(o.max_free_space_violation);
+  } else if (candidate.penetration > o.max_penetration) {
+    candidate.reason = "the model reaches " + text(candidate.penetration * 1000) +
+                       " mm into the table > " + text(o.max_penetration * 1000) + " mm";
   } else if (std::abs(table_c.x()) > setup_.play_area_width / 2 + o.play_area_margin ||
              std::abs(table_c.y()) > setup_.play_area_depth / 2 + o.play_area_margin ||
              table_c.z() > options_.segmentation.max_height + o.play_area_margin ||
@@ -238,7 +279,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   // The visible surface is about a third of the model's radius nearer than its centre.
   const Eigen::Vector3d ray = centroid.cast<double>().normalized();
   const Eigen::Vector3d center_guess = centroid.cast<double>() + 0.35 * model_->radius() * ray;
-  IcpOptions coarse_icp = options_.icp;
+  IcpOptions coarse_icp = search_icp_;
   coarse_icp.max_iterations = o.coarse_iterations;
   coarse_icp.start_distance = o.coarse_start_distance;
   coarse_icp.end_distance = o.coarse_end_distance;
@@ -251,9 +292,9 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
       const Eigen::Quaterniond camera_R_proxy = (camera_R_table * yaw * up).normalized();
       const Rigid3 camera_T_proxy(camera_R_proxy,
                                   center_guess - camera_R_proxy * model_->center().cast<double>());
-      coarse_results.push_back(AlignPointToPlane(*model_, coarse, coarse_scored,
-                                                 options_.verification.skin_distance,
-                                                 camera_T_proxy.Inverse(), coarse_icp));
+      coarse_results.push_back(
+          AlignPointToPlane(*model_, coarse, coarse_scored, options_.verification.skin_distance,
+                            camera_T_proxy.Inverse(), coarse_icp, sample_matches_));
     }
   }
   // Rank the coarse results as verified poses are ranked (track/proxy_tracker.h, Score).
@@ -261,9 +302,11 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   for (size_t i = 0; i < coarse_results.size(); ++i) {
     const Visibility visibility =
         ModelVisibility(frame, coarse_results[i].proxy_T_camera.Inverse());
+    // A pose reaching into the table is impossible (verification rejects it): ranked last.
     scores[i] = static_cast<double>(coarse_results[i].inliers + coarse_results[i].extra_inliers) /
                     coarse_scored -
-                2 * visibility.violation;
+                2 * visibility.violation -
+                (visibility.penetration > options_.verification.max_penetration ? 10.0 : 0.0);
   }
   std::vector<size_t> order(coarse_results.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -277,15 +320,22 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   };
   // Verified beats unverified; then the score, except that among poses scoring within
   // switch_margin of each other the one nearer the prediction wins (when the views of a
-  // near-symmetric proxy cannot tell its twins apart, continuity can).
+  // near-symmetric proxy cannot tell its twins apart, continuity can), and within
+  // far_switch_margin when they are more than 45 deg apart and the track is trusted (a twin: the
+  // Soldier's half turn differs only by its rifle, which the hand often hides).
   auto distance_to_prediction = [&](const Candidate& c) {
     return RotationAngle(c.icp.proxy_T_camera.Inverse().rotation, predicted->rotation);
   };
   auto better = [&](const Candidate& a, const std::optional<Candidate>& b) {
     if (!b) return true;
     if (a.good != b->good) return a.good;
-    if (predicted && std::abs(a.Score() - b->Score()) <= o.switch_margin) {
-      return distance_to_prediction(a) < distance_to_prediction(*b);
+    if (predicted) {
+      const bool far =
+          tracked_frames_ >= o.trusted_frames &&
+          RotationAngle(a.icp.proxy_T_camera.rotation, b->icp.proxy_T_camera.rotation) > pi / 4;
+      if (std::abs(a.Score() - b->Score()) <= (far ? o.far_switch_margin : o.switch_margin)) {
+        return distance_to_prediction(a) < distance_to_prediction(*b);
+      }
     }
     return a.Score() > b->Score();
   };
@@ -300,14 +350,37 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   for (size_t i = scored_; i < data_.size(); i += medium_stride) medium.push_back(data_[i]);
   auto refine = [&](const Rigid3& proxy_T_camera, const IcpOptions& icp) {
     return AlignPointToPlane(*model_, medium, medium_scored, options_.verification.skin_distance,
-                             proxy_T_camera, icp);
+                             proxy_T_camera, icp, sample_matches_);
   };
   std::vector<Rigid3> refined_poses;
   std::optional<Candidate> best;
-  for (size_t c = 0; c < order.size() && static_cast<int>(refined_poses.size()) < o.candidates &&
-                     c < static_cast<size_t>(3 * o.candidates);
+  // The motion model's poses are candidates too (the prediction and the last measured pose),
+  // refined as the twins are: the coarse hypotheses sample yaw every 30 deg, and when a
+  // near-symmetric twin scores as well as the truth (its distinguishing part under the hand), only
+  // a well-refined candidate near the prediction lets continuity decide (`better`).
+  std::vector<Rigid3> seeds;
+  if (predicted) seeds.push_back(*predicted);
+  if (last_ && (!predicted || !(last_->rotation.isApprox(predicted->rotation) &&
+                                last_->translation.isApprox(predicted->translation)))) {
+    seeds.push_back(*last_);
+  }
+  for (const Rigid3& seed : seeds) {
+    const IcpResult coarse_seed = refine(seed.Inverse(), coarse_icp);
+    const IcpResult refined = refine(coarse_seed.proxy_T_camera, search_icp_);
+    if (std::any_of(refined_poses.begin(), refined_poses.end(),
+                    [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
+      continue;
+    }
+    refined_poses.push_back(refined.proxy_T_camera);
+    Candidate candidate = Verify(frame, refined);
+    if (better(candidate, best)) best = candidate;
+  }
+  const size_t seeded = refined_poses.size();
+  for (size_t c = 0;
+       c < order.size() && static_cast<int>(refined_poses.size() - seeded) < o.candidates &&
+       c < static_cast<size_t>(3 * o.candidates);
        ++c) {
-    const IcpResult refined = refine(coarse_results[order[c]].proxy_T_camera, options_.icp);
+    const IcpResult refined = refine(coarse_results[order[c]].proxy_T_camera, search_icp_);
     if (std::any_of(refined_poses.begin(), refined_poses.end(),
                     [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
       continue;
@@ -331,7 +404,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
         const Rigid3 proxy_T_twin(turn, center - turn * center);
         // Coarse first (the turn about the centre need not be the symmetry's), then fine.
         const IcpResult coarse_twin = refine((camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp);
-        const IcpResult refined = refine(coarse_twin.proxy_T_camera, options_.icp);
+        const IcpResult refined = refine(coarse_twin.proxy_T_camera, search_icp_);
         if (same_pose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
         Candidate candidate = Verify(frame, refined);
         if (better(candidate, best)) best = candidate;
@@ -341,7 +414,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   if (best) {
     best = Verify(frame,
                   AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                                    best->icp.proxy_T_camera, options_.icp));
+                                    best->icp.proxy_T_camera, search_icp_, sample_matches_));
   }
   return best;
 }
@@ -352,7 +425,7 @@ ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
   if (!camera_T_table_) return score;
   const IcpResult icp =
       AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                        camera_T_proxy.Inverse(), options_.icp);
+                        camera_T_proxy.Inverse(), search_icp_, sample_matches_);
   const Candidate candidate = Verify(frame, icp);
   score.camera_T_proxy = icp.proxy_T_camera.Inverse();
   score.inlier_share = icp.inlier_share;
@@ -400,6 +473,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     last_.reset();
     velocity_.reset();
     predicted_frames_ = 0;
+    tracked_frames_ = 0;
     return result;
   };
   // The frame itself.
@@ -457,7 +531,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   if (predicted && enough) {
     const IcpResult icp =
         AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                          predicted->Inverse(), options_.icp);
+                          predicted->Inverse(), options_.icp, sample_matches_);
     Candidate candidate = Verify(frame, icp);
     if (candidate.good) {
       chosen = candidate;
@@ -481,7 +555,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
         segment_whole_play_area();
         chosen = Verify(
             frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                                     chosen->icp.proxy_T_camera, options_.icp));
+                                     chosen->icp.proxy_T_camera, options_.icp, sample_matches_));
       }
       std::optional<Candidate> detected = Detect(frame, predicted);
       if (detected && detected->good &&
@@ -521,6 +595,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     }
     last_ = camera_T_proxy;
     predicted_frames_ = 0;
+    ++tracked_frames_;
     result.status = TrackStatus::kTracked;
     result.camera_T_proxy = camera_T_proxy;
     result.inlier_share = chosen->icp.inlier_share;

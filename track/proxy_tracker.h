@@ -60,6 +60,11 @@ struct DetectionOptions {
   // ... and far_switch_margin higher when it is more than 45 deg from the tracked pose (a verified
   // pose does not turn that far in a frame: such a switch is to a twin, or from one).
   double far_switch_margin = 0.15;
+  // ... and within the detection, a candidate more than 45 deg from another wins over the one
+  // nearer the prediction only when it scores far_switch_margin higher, once the track has been
+  // measured for trusted_frames frames since its last loss (before that, a fresh detection may
+  // still have picked a near-symmetric twin: switch_margin decides).
+  int trusted_frames = 30;
 
   template <class V>
   void VisitFields(V& v) {
@@ -78,6 +83,7 @@ struct DetectionOptions {
     v("recheck_free_space", recheck_free_space);
     v("switch_margin", switch_margin);
     v("far_switch_margin", far_switch_margin);
+    v("trusted_frames", trusted_frames);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -96,10 +102,19 @@ struct VerificationOptions {
   // The proxy's centre must lie within the play area grown by this margin [m] and below
   // segmentation.max_height.
   double play_area_margin = 0.06;
+  // The proxy cannot reach into the table: a pose whose model lies more than max_penetration [m]
+  // below the estimated table plane is rejected (the Soldier's upside-down twin, standing on its
+  // head inside the table, explains the visible body as well as the true pose does when the hand
+  // hides the head).
+  double max_penetration = 0.01;
   // Frames a pose may be extrapolated without a measurement before it is reported lost.
   int max_predicted_frames = 10;
   // Skin-coloured points help the fit only within this distance of the model [m].
   double skin_distance = 0.004;
+  // Colour consistency (needs a model with face colours): skin-coloured points match only model
+  // surfaces that can look skin-coloured (the Soldier's head and rifle), the other points only
+  // surfaces that can look otherwise (track/point_to_plane_icp.h, sample_matches).
+  bool colour_matching = true;
   // At most this many segmented points enter the ICP (evenly subsampled) [points].
   int max_points = 1500;
 
@@ -111,18 +126,29 @@ struct VerificationOptions {
     v("max_free_space_violation", max_free_space_violation);
     v("free_space_margin", free_space_margin);
     v("play_area_margin", play_area_margin);
+    v("max_penetration", max_penetration);
     v("max_predicted_frames", max_predicted_frames);
     v("skin_distance", skin_distance);
+    v("colour_matching", colour_matching);
     v("max_points", max_points);
   }
   void Validate(const std::string& prefix) const;
 };
 
+// The tracker's ICP: IcpOptions' defaults with the motion prior on (2 deg, 3 mm), which only the
+// frame-to-frame ICP from the prediction uses; the detection's and the scores' ICPs run without.
+inline IcpOptions TrackingIcpOptions() {
+  IcpOptions icp;
+  icp.prior_rotation_deg = 2.0;
+  icp.prior_translation = 0.003;
+  return icp;
+}
+
 struct ProxyTrackerOptions {
   TablePlaneOptions table;
   SegmentationOptions segmentation;
   ProxyModelOptions model;
-  IcpOptions icp;
+  IcpOptions icp = TrackingIcpOptions();
   DetectionOptions detection;
   VerificationOptions verification;
 
@@ -197,9 +223,11 @@ class ProxyTracker {
   Candidate Verify(const RgbdFrame& frame, const IcpResult& icp) const;
   // Of the model's camera-facing sparse samples with a depth reading: the share whose depth the
   // frame confirms (within free_space_margin) and the share it sees behind (free space).
+  // Also how deep the model reaches below the table plane [m] (0 when it does not).
   struct Visibility {
     double explained = 0.0;
     double violation = 0.0;
+    double penetration = 0.0;
   };
   Visibility ModelVisibility(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
   // The image of the model's bounding sphere grown by `margin` [m] (and 4 px).
@@ -218,9 +246,14 @@ class ProxyTracker {
   std::optional<Rigid3> velocity_;  // last * previous^-1 (camera frame, per frame)
   int predicted_frames_ = 0;
   int frames_since_detection_ = 0;
+  int tracked_frames_ = 0;  // measured frames since the last loss
   // Scratch: the subsampled segmented points (the first scored_), then the skin points.
   std::vector<Eigen::Vector3f> data_;
   std::vector<Eigen::Vector3f> detection_scratch_;
+  // Per model sample: which data it may match (kMatchesScored | kMatchesExtra); empty: all.
+  std::vector<uint8_t> sample_matches_;
+  // options_.icp without the motion prior (detection, scoring).
+  IcpOptions search_icp_;
   size_t scored_ = 0;
 };
 
