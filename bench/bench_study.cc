@@ -47,7 +47,12 @@ void BM_StudyFast(benchmark::State& state) {
     Report(state, s);
   }
 }
-BENCHMARK(BM_StudyFast)->ArgName("animators")->Arg(20)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_StudyFast)
+    ->ArgName("animators")
+    ->Arg(20)
+    ->Unit(benchmark::kSecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 // Full fidelity: every recording and annotation session rendered, tracked and read.
 void BM_StudyFull(benchmark::State& state) {
@@ -63,6 +68,7 @@ BENCHMARK(BM_StudyFull)
     ->Arg(3)
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
+    ->MeasureProcessCPUTime()
     ->UseRealTime();
 
 // Phase 2 and the analysis alone: the design, 420 judgements, 80 rankings, every test.
