@@ -186,9 +186,12 @@ ProxyTracker::Visibility ProxyTracker::ModelVisibility(const RgbdFrame& frame,
     const Eigen::Vector3f c = r * model_->points()[i] + t;
     lowest = std::min(lowest, up.dot(c) - up_offset);
     if (c.z() <= 0.05f || (r * model_->normals()[i]).dot(c) >= 0) continue;
-    const int u = static_cast<int>(std::lround(k.fx * c.x() / c.z() + k.cx));
-    const int v = static_cast<int>(std::lround(k.fy * c.y() / c.z() + k.cy));
-    if (u < 0 || v < 0 || u >= k.width || v >= k.height) continue;
+    // Rounded to the nearest pixel; std::lround is a library call, and for the coordinates kept
+    // (x >= -0.5) floor(x + 0.5) rounds the same.
+    const double x = k.fx * c.x() / c.z() + k.cx + 0.5;
+    const double y = k.fy * c.y() / c.z() + k.cy + 0.5;
+    if (!(x >= 0 && y >= 0 && x < k.width && y < k.height)) continue;
+    const int u = static_cast<int>(x), v = static_cast<int>(y);
     const uint16_t d = frame.depth[static_cast<size_t>(v) * k.width + u];
     if (d == 0) continue;
     ++seen;
