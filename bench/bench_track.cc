@@ -30,24 +30,41 @@ struct Take {
   TrackSetup setup;
 };
 
+Take RenderTake(test_take::SimTake& sim) {
+  Take t;
+  for (int i = 0; i < kFrames; ++i) {
+    Rigid3 camera_T_proxy;
+    t.frames.push_back(sim.Render(i, &camera_T_proxy));
+    t.truth.push_back(camera_T_proxy);
+  }
+  t.model = sim.model();
+  t.setup = sim.Setup();
+  return t;
+}
+
+// The demo walk.
 const Take& GetTake() {
   static const Take take = [] {
-    Take t;
     test_take::SimTake sim;
-    for (int i = 0; i < kFrames; ++i) {
-      Rigid3 camera_T_proxy;
-      t.frames.push_back(sim.Render(i, &camera_T_proxy));
-      t.truth.push_back(camera_T_proxy);
-    }
-    t.model = sim.model();
-    t.setup = sim.Setup();
-    return t;
+    return RenderTake(sim);
   }();
   return take;
 }
 
-void SetAccuracy(benchmark::State& state, const std::vector<std::optional<Rigid3>>& estimates) {
-  const Take& take = GetTake();
+// The first frames of a Soldier story take (participant 0, take 0: marching in front of the
+// castle, seen from the side, with the checks and detections that view costs).
+const Take& GetStoryTake() {
+  static const Take take = [] {
+    int frames = 0;
+    test_take::SimTake sim = test_take::SoldierStorySession(
+        MMH_BENCH_SOURCE_DIR, 0, 0, sim::RenderSession::kRecording, &frames);
+    return RenderTake(sim);
+  }();
+  return take;
+}
+
+void SetAccuracy(benchmark::State& state, const Take& take,
+                 const std::vector<std::optional<Rigid3>>& estimates) {
   const auto points = metrics::MetricPoints(take.model);
   const metrics::PoseErrorOptions options;
   const auto errors = metrics::ComputePoseErrors(estimates, take.truth, points, options);
@@ -61,8 +78,7 @@ void SetAccuracy(benchmark::State& state, const std::vector<std::optional<Rigid3
 
 // The whole tracker per frame: segmentation, prediction, ICP, verification (the table plane and the
 // first detection included, amortised over the take).
-void BM_ProxyTracker(benchmark::State& state) {
-  const Take& take = GetTake();
+void TrackTake(benchmark::State& state, const Take& take) {
   std::vector<std::optional<Rigid3>> estimates;
   for (auto _ : state) {
     state.PauseTiming();
@@ -76,9 +92,12 @@ void BM_ProxyTracker(benchmark::State& state) {
     }
   }
   state.SetItemsProcessed(state.iterations() * kFrames);
-  SetAccuracy(state, estimates);
+  SetAccuracy(state, take, estimates);
 }
+void BM_ProxyTracker(benchmark::State& state) { TrackTake(state, GetTake()); }
 BENCHMARK(BM_ProxyTracker)->Unit(benchmark::kMillisecond);
+void BM_ProxyTrackerStory(benchmark::State& state) { TrackTake(state, GetStoryTake()); }
+BENCHMARK(BM_ProxyTrackerStory)->Unit(benchmark::kMillisecond);
 
 // Segmentation alone (play volume, background model, skin, connected components).
 void BM_Segmentation(benchmark::State& state) {
@@ -125,7 +144,7 @@ void BM_PclIcpWithNormals(benchmark::State& state) {
     for (const RgbdFrame& frame : take.frames) estimates.push_back(baseline.Track(frame));
   }
   state.SetItemsProcessed(state.iterations() * kFrames);
-  SetAccuracy(state, estimates);
+  SetAccuracy(state, take, estimates);
 }
 BENCHMARK(BM_PclIcpWithNormals)->Unit(benchmark::kMillisecond);
 
