@@ -134,5 +134,15 @@ TEST(RunCliTest, RegressPassesItsOwnBaselineAndCatchesAChange) {
   EXPECT_NE(ReadBytes(dir / "moved/regress.csv").find("REGRESSED"), std::string::npos);
 }
 
+// The committed short baseline (tests/data/regress): a change in the simulation, the sensor, the
+// tracker or the compositor that moves a metric beyond its tolerance fails here.
+TEST(RunCliTest, TheCommittedShortBaselinePasses) {
+  TempDir dir;
+  const auto r = RunMmh("regress --baseline " + kSource + "/tests/data/regress --out " +
+                        (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(" 0 regressed or missing"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace mmh
