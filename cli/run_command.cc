@@ -185,8 +185,9 @@ void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
   std::printf(
       "  montage: %d frames, %d segments (shortest %d), quality %.3f (best take %+.3f), "
       "constraint +%.2f %%, label agreement with the ground-truth montage %.1f %%\n",
-      mt["frames"].get<int>(), mt["segments"].get<int>(), mt["shortest_segment_frames"].get<int>(),
-      mt["mean_quality"].get<double>(), mt["quality_gain_over_best_take"].get<double>(),
+      mt["montage_frames"].get<int>(), mt["segments"].get<int>(),
+      mt["shortest_segment_montage_frames"].get<int>(), mt["mean_quality"].get<double>(),
+      mt["quality_gain_over_best_take"].get<double>(),
       mt["constraint_increase_percent"].get<double>(),
       100 * m["montage"]["tracked_vs_truth"]["label_agreement"].get<double>());
   std::printf(

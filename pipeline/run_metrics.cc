@@ -133,21 +133,10 @@ nlohmann::json MontageMetrics(const montage::Montage& m, const std::vector<doubl
                               const std::vector<Trajectory>& takes,
                               const std::vector<std::vector<double>>& take_quality,
                               double frame_rate, int blend_window) {
-  const montage::ComposeSummary& s = m.summary;
-  nlohmann::json j;
-  j["total_cost"] = s.total_cost;
-  j["data_cost"] = s.data_cost;
-  j["smoothness_cost"] = s.smoothness_cost;
-  j["unconstrained_cost"] = s.unconstrained_cost;
-  j["constraint_increase_percent"] = s.constraint_increase_percent;
-  j["unconstrained_segments"] = s.unconstrained_segments;
-  j["unconstrained_short_segments"] = s.unconstrained_short_segments;
-  j["segments"] = static_cast<int>(m.segments.size());
-  j["shortest_segment_reference_frames"] = s.shortest_segment_reference;
-  j["shortest_segment_frames"] = s.shortest_segment_montage;
-  j["frames"] = s.montage_frames;
-  j["reference_frames"] = s.reference_frames;
-  j["warnings"] = s.warnings;
+  // The compositor's summary (costs, the constraint's cost, segments; montage/compose.h) without
+  // its timings, then what the montage achieved.
+  nlohmann::json j = montage::SummaryToJson(m.summary, m.segments);
+  j.erase("seconds");
 
   // Liked frames used: of the reference frames where some take is liked (warped annotation > 0),
   // the share whose chosen take is liked. Disliked frames avoided: of the reference frames where
