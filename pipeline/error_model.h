@@ -38,26 +38,26 @@ namespace mmh::pipeline {
 
 struct ErrorModelOptions {
   // Every default is measured (EstimateErrorModel) on the full-fidelity study of
-  // configs/study_soldier.json: 20 animators, 60 Soldier takes, 124 487 tracked and read frames
-  // (docs/study.md, "Fidelity").
+  // configs/study_soldier.json: 20 animators, 60 Soldier takes, 124 487 tracked and read frames,
+  // with the tracker of commit ea8e4c8 (docs/study.md, "Fidelity").
   // Pose errors (see above), per axis in the proxy frame, over the frames within the tracker's
   // success criterion.
-  double translation_sd = 0.00109;  // σ_e [m]
-  double rotation_sd = 0.0170;      // σ_r [rad]
-  double correlation = 0.498;       // ρ, lag one, in [0, 1)
+  double translation_sd = 0.00110;  // σ_e [m]
+  double rotation_sd = 0.0160;      // σ_r [rad]
+  double correlation = 0.678;       // ρ, lag one, in [0, 1)
   // Flips (see above): episodes per frame, mean length [frames], rotation [rad], translation [m].
-  double flip_rate = 0.00428;
-  double flip_mean_frames = 7.97;
-  double flip_rotation = 3.13;
-  double flip_translation = 0.0078;
+  double flip_rate = 0.00158;
+  double flip_mean_frames = 23.5;
+  double flip_rotation = 3.14;
+  double flip_translation = 0.0061;
   // Spikes (see above): episodes per frame, mean length [frames], per-axis sizes [rad], [m].
-  double spike_rate = 0.0122;
-  double spike_mean_frames = 1.75;
-  double spike_rotation_sd = 0.105;
-  double spike_translation_sd = 0.0053;
+  double spike_rate = 0.00479;
+  double spike_mean_frames = 2.35;
+  double spike_rotation_sd = 0.0974;
+  double spike_translation_sd = 0.0056;
   // Losses: episodes per frame, mean length [frames]; their frames are reported lost.
-  double loss_rate = 0.0056;
-  double loss_mean_frames = 2.32;
+  double loss_rate = 0.00101;
+  double loss_mean_frames = 1.70;
   // Slider reading: AR(1) noise [slider units] with its lag-one correlation, a bias, and the share
   // of frames in which the block is not found.
   double slider_sd = 0.164;
