@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <numbers>
+#include <random>
 
 #include "core/error.h"
 #include "tests/test_util.h"
@@ -116,6 +117,43 @@ TEST(TrackingMetricsTest, MetricPointsAreDistinctVertices) {
   mesh.face_colors.setConstant(2, 3, 100);
   EXPECT_EQ(MetricPoints(mesh).rows(), 4);
   EXPECT_EQ(MetricPoints(mesh, 2).rows(), 2);
+}
+
+}  // namespace
+}  // namespace mmh::metrics
+
+namespace mmh::metrics {
+namespace {
+
+// ADD-S's nearest-neighbour search against brute force, on random points and poses.
+TEST(TrackingMetricsTest, AddSMatchesBruteForce) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal(0.0, 0.02);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> points(300, 3);
+  for (int i = 0; i < 300; ++i) points.row(i) << normal(rng), normal(rng), 2 * normal(rng);
+  std::vector<std::optional<Rigid3>> estimates;
+  std::vector<Rigid3> truth;
+  for (int f = 0; f < 20; ++f) {
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3 * f, Eigen::Vector3d(1, f, 2).normalized()));
+    truth.emplace_back(q, Eigen::Vector3d(normal(rng), normal(rng), 0.6));
+    const Eigen::Quaterniond e =
+        q * Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * f, Eigen::Vector3d::UnitY()));
+    estimates.emplace_back(Rigid3(e, truth.back().translation + Eigen::Vector3d(0.001 * f, 0, 0)));
+  }
+  const auto errors = ComputePoseErrors(estimates, truth, points, PoseErrorOptions{});
+  for (int f = 0; f < 20; ++f) {
+    double adds = 0.0;
+    for (int i = 0; i < 300; ++i) {
+      const Eigen::Vector3d b = truth[f] * Eigen::Vector3d(points.row(i).transpose());
+      double nearest = 1e300;
+      for (int j = 0; j < 300; ++j) {
+        const Eigen::Vector3d a = *estimates[f] * Eigen::Vector3d(points.row(j).transpose());
+        nearest = std::min(nearest, (b - a).norm());
+      }
+      adds += nearest;
+    }
+    EXPECT_NEAR(errors[f].adds, adds / 300, 1e-12) << f;
+  }
 }
 
 }  // namespace
