@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -59,34 +60,6 @@ class ProgressBar {
 
 namespace {
 
-// The first key path where `a` and `b` differ ("" when equal), with both values.
-std::string FirstDifference(const nlohmann::json& a, const nlohmann::json& b,
-                            const std::string& path, std::string* value_a, std::string* value_b) {
-  if (a.is_object() && b.is_object()) {
-    for (const auto& [key, value] : a.items()) {
-      const std::string p = path.empty() ? key : path + "." + key;
-      if (!b.contains(key)) {
-        *value_a = value.dump(), *value_b = "nothing";
-        return p;
-      }
-      const std::string d = FirstDifference(value, b[key], p, value_a, value_b);
-      if (!d.empty()) return d;
-    }
-    for (const auto& [key, value] : b.items()) {
-      if (!a.contains(key)) {
-        *value_a = "nothing", *value_b = value.dump();
-        return path.empty() ? key : path + "." + key;
-      }
-    }
-    return "";
-  }
-  if (a != b) {
-    *value_a = a.dump(), *value_b = b.dump();
-    return path.empty() ? "(the whole config)" : path;
-  }
-  return "";
-}
-
 // --resume continues a run whose sessions were made with the same config: only the sections
 // that come after the sessions (montage, metrics, run.min_tracked_share) may change.
 void CheckResumable(const std::filesystem::path& out, const nlohmann::json& resolved) {
@@ -105,10 +78,17 @@ void CheckResumable(const std::filesystem::path& out, const nlohmann::json& reso
     j->erase("metrics");
     if (j->contains("run")) (*j)["run"].erase("min_tracked_share");
   }
-  std::string value_earlier, value_now;
-  const std::string key = FirstDifference(earlier, now, "", &value_earlier, &value_now);
-  if (!key.empty()) {
-    ThrowBadValue(file.string() + ": " + key, value_earlier,
+  // The first difference, as a JSON patch from the earlier config to this one.
+  const nlohmann::json patch = nlohmann::json::diff(earlier, now);
+  if (!patch.empty()) {
+    const std::string path = patch[0]["path"].get<std::string>();
+    const nlohmann::json::json_pointer pointer(path);
+    std::string key = path.empty() ? "" : path.substr(1);
+    std::replace(key.begin(), key.end(), '/', '.');
+    const std::string value_earlier =
+        earlier.contains(pointer) ? earlier[pointer].dump() : "nothing";
+    const std::string value_now = now.contains(pointer) ? now[pointer].dump() : "nothing";
+    ThrowBadValue(file.string() + ": " + (key.empty() ? "(the whole config)" : key), value_earlier,
                   value_now +
                       " as in this run's config (the sessions would differ; only "
                       "montage, metrics and run.min_tracked_share may change with "

@@ -94,62 +94,46 @@ void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOption
   job.seconds = SecondsSince(start);
 }
 
-// The recorded take as the system has it: poses in the tracker's table frame, lost frames filled.
-void CollectRecording(const SessionJob& job, const RunOptions& options, TakeRun& take) {
+// The take as the system has it: `poses` (table_T_proxy; those of lost frames are ignored) with
+// the lost frames filled for the compositor, on the ground truth's timestamps.
+void SetTracked(std::vector<Rigid3> poses, std::vector<track::TrackStatus> status, TakeRun& take) {
+  std::vector<bool> estimated(status.size());
+  for (size_t i = 0; i < status.size(); ++i) estimated[i] = status[i] != track::TrackStatus::kLost;
+  if (std::count(estimated.begin(), estimated.end(), true) > 0) FillGaps(poses, estimated);
+  take.tracked.poses = std::move(poses);
+  take.tracked.timestamps = take.truth.timestamps;
+  take.status = std::move(status);
+}
+
+// A recording session's results: poses in the tracker's estimated table frame.
+void CollectRecording(const SessionJob& job, TakeRun& take) {
   const int frames = static_cast<int>(job.run.frames.size());
-  const double fps = take.performed.table_T_proxy.size() > 1
-                         ? 1.0 / (take.performed.table_T_proxy.timestamps[1] -
-                                  take.performed.table_T_proxy.timestamps[0])
-                         : 30.0;
   take.camera_T_table = job.camera_T_table;
   take.estimated_camera_T_table = job.run.camera_T_table.value_or(job.camera_T_table);
   const Rigid3 table_T_camera = take.estimated_camera_T_table.Inverse();
   std::vector<Rigid3> poses(frames);
-  std::vector<bool> estimated(frames, false);
-  take.status.resize(frames);
+  std::vector<track::TrackStatus> status(frames);
   for (int i = 0; i < frames; ++i) {
     const track::TrackFrameResult& r = job.run.frames[i];
-    take.status[i] = r.status;
-    if (r.status != track::TrackStatus::kLost) {
-      poses[i] = table_T_camera * r.camera_T_proxy;
-      estimated[i] = true;
-    }
+    status[i] = r.status;
+    if (r.status != track::TrackStatus::kLost) poses[i] = table_T_camera * r.camera_T_proxy;
   }
-  const int estimated_count =
-      static_cast<int>(std::count(estimated.begin(), estimated.end(), true));
-  take.estimated_share = frames > 0 ? static_cast<double>(estimated_count) / frames : 0.0;
-  if (estimated_count > 0) FillGaps(poses, estimated);
-  take.tracked.poses = std::move(poses);
-  take.tracked.timestamps.resize(frames);
-  for (int i = 0; i < frames; ++i) take.tracked.timestamps[i] = i / fps;
-  take.record_seconds = job.seconds;
-  (void)options;
+  SetTracked(std::move(poses), std::move(status), take);
 }
 
 void CollectAnnotation(const SessionJob& job, TakeRun& take) {
   take.read_annotation = job.run.annotation;
   take.slider_found.resize(job.run.slider.size());
   for (size_t i = 0; i < job.run.slider.size(); ++i) take.slider_found[i] = job.run.slider[i].found;
-  take.annotate_seconds = job.seconds;
 }
 
 // Stand-ins for the sessions in fast fidelity: the error model applied to the ground truth.
 void SimulateSessions(const RunConfig& config, std::uint64_t seed, TakeRun& take) {
-  const SimulatedTracking tracking = SimulateTracking(
-      take.performed.table_T_proxy, config.error_model,
+  SimulatedTracking tracking = SimulateTracking(
+      take.truth, config.error_model,
       sim::DeriveSeed(seed, {0x7472ull, static_cast<std::uint64_t>(take.performed.object),
                              static_cast<std::uint64_t>(take.take)}));
-  const int frames = take.performed.frames();
-  std::vector<Rigid3> poses = tracking.tracked.poses;
-  std::vector<bool> estimated(frames);
-  for (int i = 0; i < frames; ++i) estimated[i] = tracking.status[i] != track::TrackStatus::kLost;
-  const int estimated_count =
-      static_cast<int>(std::count(estimated.begin(), estimated.end(), true));
-  take.estimated_share = frames > 0 ? static_cast<double>(estimated_count) / frames : 0.0;
-  if (estimated_count > 0) FillGaps(poses, estimated);
-  take.tracked.poses = std::move(poses);
-  take.tracked.timestamps = take.performed.table_T_proxy.timestamps;
-  take.status = tracking.status;
+  SetTracked(std::move(tracking.tracked.poses), std::move(tracking.status), take);
   if (!take.truth_annotation.values.empty()) {
     const SimulatedReading reading = SimulateSliderReading(
         take.truth_annotation, config.error_model,
@@ -177,6 +161,14 @@ std::vector<double> MontageQuality(const montage::Montage& m, const std::vector<
 }  // namespace
 
 std::span<const std::pair<Fidelity, const char*>> EnumNames(Fidelity) { return kFidelityNames; }
+
+double TakeRun::EstimatedShare() const {
+  if (status.empty()) return 0.0;
+  const auto estimated = std::count_if(status.begin(), status.end(), [](track::TrackStatus s) {
+    return s != track::TrackStatus::kLost;
+  });
+  return static_cast<double>(estimated) / status.size();
+}
 
 void RunOptions::Validate(const std::string& prefix) const {
   if (takes < 2) {
@@ -316,21 +308,23 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     }
   }
 
+  // The proxies' models: rendered by the sensor, given to the tracker, and the metrics' points.
+  std::vector<TriangleMesh> models;
+  std::vector<std::string> model_names;
+  const std::string main_proxy = render.render.proxy.empty()
+                                     ? sim::StoryProxyFile(render.render.story, story, object)
+                                     : render.render.proxy;
+  models.push_back(sim::LoadProxyModel(main_proxy, render.render.proxy_scale));
+  model_names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
+  if (practice_takes) {
+    const std::string practice_proxy = sim::StoryProxyFile(options.practice, *practice_story, 0);
+    models.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
+    model_names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
+  }
+
   if (options.fidelity == Fidelity::kFull) {
     // Every session is its own job (scene, sensor, tracker); jobs run in parallel and each renders
     // its frames in order, so the results do not depend on the thread count.
-    std::vector<TriangleMesh> models;
-    std::vector<std::string> model_names;
-    const std::string main_proxy = render.render.proxy.empty()
-                                       ? sim::StoryProxyFile(render.render.story, story, object)
-                                       : render.render.proxy;
-    models.push_back(sim::LoadProxyModel(main_proxy, render.render.proxy_scale));
-    model_names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
-    if (practice_takes) {
-      const std::string practice_proxy = sim::StoryProxyFile(options.practice, *practice_story, 0);
-      models.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
-      model_names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
-    }
     std::vector<SessionJob> jobs;
     std::int64_t total_frames = 0;
     for (size_t slot = 0; slot < takes.size(); ++slot) {
@@ -399,7 +393,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
         CollectAnnotation(job, t);
         annotate_cpu += job.seconds;
       } else {
-        CollectRecording(job, options, t);
+        CollectRecording(job, t);
         record_cpu += job.seconds;
       }
     }
@@ -412,10 +406,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     t0 = Clock::now();
     for (TakeRun& t : takes) {
       if (loaded[&t - takes.data()]) continue;
-      const Trajectory full = t.performed.table_T_proxy;
-      t.performed.table_T_proxy = t.truth;  // the error model sees the (possibly shortened) take
       SimulateSessions(config, seed, t);
-      t.performed.table_T_proxy = full;
       if (progress) progress(&t - takes.data() + 1, static_cast<std::int64_t>(takes.size()));
     }
     result.seconds.record = SecondsSince(t0);
@@ -431,8 +422,8 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     for (const TakeRun& t : result.takes) take_done(t, false);
   }
   auto check_tracked = [&](const TakeRun& t, const std::string& what) {
-    if (t.estimated_share < options.min_tracked_share) {
-      throw RunError(what + ": tracking failed: " + FormatNumber(100.0 * t.estimated_share) +
+    if (t.EstimatedShare() < options.min_tracked_share) {
+      throw RunError(what + ": tracking failed: " + FormatNumber(100.0 * t.EstimatedShare()) +
                      " % of its " + std::to_string(t.status.size()) +
                      " frames have a pose, run.min_tracked_share asks for at least " +
                      FormatNumber(100.0 * options.min_tracked_share) +
@@ -462,7 +453,8 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
 
   // metrics.json holds no timings (same config and seed, same bytes); they go to run.json.
   t0 = Clock::now();
-  result.metrics = ComputeRunMetrics(config, result);
+  result.metrics =
+      ComputeRunMetrics(config, result, models[0], practice_takes ? &models[1] : nullptr);
   result.seconds.metrics = SecondsSince(t0);
   result.seconds.total = SecondsSince(start);
   return result;

@@ -93,7 +93,6 @@ struct TakeRun {
   Trajectory truth;    // #frames: the performed motion (render.frames may shorten the take)
   Trajectory tracked;  // #frames, lost frames filled (see RunOptions)
   std::vector<track::TrackStatus> status;  // #frames
-  double estimated_share = 0.0;            // share of frames not lost
   // The depth camera's pose over the table: true, and as the tracker estimated it (the plane it
   // found and the setup's tape marks). Identity for both in fast fidelity.
   Rigid3 camera_T_table;
@@ -101,8 +100,9 @@ struct TakeRun {
   Annotation truth_annotation;     // the slider block's true values
   Annotation read_annotation;      // the slider reader's values (held where not found)
   std::vector<bool> slider_found;  // #frames
-  double record_seconds = 0.0;     // render + track of the recording session [s]
-  double annotate_seconds = 0.0;   // render + read of the annotation session [s]
+
+  // Share of frames not lost.
+  double EstimatedShare() const;
 };
 
 struct StageSeconds {

@@ -225,7 +225,9 @@ nlohmann::json MontageMetrics(const montage::Montage& m, const std::vector<doubl
 
 }  // namespace
 
-nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run) {
+nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run,
+                                 const TriangleMesh& proxy_model,
+                                 const TriangleMesh* practice_model) {
   const sim::RenderConfig& render = config.render;
   const double fps = render.performance.frame_rate;
   nlohmann::json j;
@@ -235,13 +237,8 @@ nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run
       {"practice", config.run.practice},       {"fidelity", EnumName(config.run.fidelity)},
       {"rendered_frames", run.rendered_frames}};
 
-  // The proxies' metric points (ADD/ADD-S), from the same models the sensor rendered.
-  const sim::Story story = sim::LoadStory(render.render.story, render.scene);
-  const std::string proxy =
-      render.render.proxy.empty()
-          ? sim::StoryProxyFile(render.render.story, story, render.render.object)
-          : render.render.proxy;
-  const auto points = metrics::MetricPoints(sim::LoadProxyModel(proxy, render.render.proxy_scale));
+  // The proxy's metric points (ADD/ADD-S), from the model the sensor rendered.
+  const auto points = metrics::MetricPoints(proxy_model);
 
   std::vector<double> rotation, translation, practice_rotation, practice_translation;
   nlohmann::json takes = nlohmann::json::array();
@@ -264,9 +261,7 @@ nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run
   }
   j["takes"] = takes;
   if (run.practice) {
-    const sim::Story practice = sim::LoadStory(config.run.practice, render.scene);
-    const auto practice_points = metrics::MetricPoints(
-        sim::LoadProxyModel(sim::StoryProxyFile(config.run.practice, practice, 0), 1.0));
+    const auto practice_points = metrics::MetricPoints(*practice_model);
     j["practice"] = {{"take", run.practice->take},
                      {"frames", static_cast<int>(run.practice->truth.poses.size())},
                      {"mean_quality",

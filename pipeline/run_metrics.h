@@ -10,12 +10,18 @@
 #include <string>
 #include <vector>
 
+#include "core/triangle_mesh.h"
+
 namespace mmh::pipeline {
 
 struct RunConfig;
 struct AnimatorRun;
 
-nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run);
+// `proxy_model` and `practice_model` (when the run has a practice take) are the models the
+// sessions rendered (for ADD/ADD-S).
+nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run,
+                                 const TriangleMesh& proxy_model,
+                                 const TriangleMesh* practice_model);
 
 // Time per stage [s] and frames per second (metrics.json "seconds").
 nlohmann::json SecondsToJson(const AnimatorRun& run);

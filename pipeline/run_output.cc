@@ -165,9 +165,6 @@ bool LoadTakeRun(const std::filesystem::path& out, TakeRun& take, bool practice)
   if (row != frames) {
     inconsistent("status.csv", std::to_string(row) + " rows", std::to_string(frames) + " frames");
   }
-  const auto estimated = std::count_if(take.status.begin(), take.status.end(),
-                                       [](auto s) { return s != track::TrackStatus::kLost; });
-  take.estimated_share = frames > 0 ? static_cast<double>(estimated) / frames : 0.0;
   if (annotated) {
     if (!std::filesystem::exists(dir / "read_annotation.csv")) {
       inconsistent("read_annotation.csv", "missing", "the file");
