@@ -455,6 +455,21 @@ MMH_SIMD_CLONES void DepthRowPortable(const DepthParams& q, const float* up, con
   }
 }
 
+// Edge flags as bits: pixel u of a row is bit u % 64 of word u / 64 (#ceil(n / 64) words), so
+// that the scalar edge pass visits only the rare edge pixels. ORs the 16 flags of pixels
+// i .. i + 15 in (they lie in the row: no word past the row's last is touched).
+inline void SetEdgeBits(uint64_t* words, int i, uint32_t flags16) {
+  const int shift = i & 63;
+  words[i >> 6] |= static_cast<uint64_t>(flags16) << shift;
+  if (shift > 48) words[(i >> 6) + 1] |= static_cast<uint64_t>(flags16) >> (64 - shift);
+}
+// ORs the byte flags edge[first .. last) into the bits.
+inline void PackEdgeBits(const uint8_t* edge, int first, int last, uint64_t* words) {
+  for (int u = first; u < last; ++u) {
+    words[u >> 6] |= static_cast<uint64_t>(edge[u] != 0) << (u & 63);
+  }
+}
+
 // One colour byte from its hash h: slot j of value v stands for the byte v - 2^(slot_bits - 1) + j
 // with probability threshold / 2^kColorThresholdBits, otherwise for its alias.
 inline uint8_t NoisyColor(const ColorParams& p, uint8_t value, uint32_t h) {
@@ -492,14 +507,28 @@ MMH_AVX512 inline __m512i Mix32x16(__m512i x) {
   x = _mm512_xor_si512(x, _mm512_srli_epi32(x, 16));
   return x;
 }
+// (first + j) * 0x9E3779B9 mod 2^32 for lanes j = 0 .. 15, as first * 0x9E3779B9 + j * 0x9E3779B9:
+// the same words as CounterHash's product, for an addition instead of a vector multiply.
+MMH_AVX512 inline __m512i ScrambledCounters(uint32_t first) {
+  constexpr uint32_t kGolden = 0x9E3779B9u;
+  return _mm512_add_epi32(
+      _mm512_set1_epi32(static_cast<int>(first * kGolden)),
+      _mm512_setr_epi32(0, static_cast<int>(kGolden), static_cast<int>(2 * kGolden),
+                        static_cast<int>(3 * kGolden), static_cast<int>(4 * kGolden),
+                        static_cast<int>(5 * kGolden), static_cast<int>(6 * kGolden),
+                        static_cast<int>(7 * kGolden), static_cast<int>(8 * kGolden),
+                        static_cast<int>(9 * kGolden), static_cast<int>(10 * kGolden),
+                        static_cast<int>(11 * kGolden), static_cast<int>(12 * kGolden),
+                        static_cast<int>(13 * kGolden), static_cast<int>(14 * kGolden),
+                        static_cast<int>(15 * kGolden)));
+}
+// CounterHash of the counters behind ScrambledCounters(first).
+MMH_AVX512 inline __m512i CounterHashx16(uint32_t key, __m512i scrambled) {
+  return Mix32x16(_mm512_xor_si512(scrambled, _mm512_set1_epi32(static_cast<int>(key))));
+}
 // CounterHash of counters first .. first + 15.
 MMH_AVX512 inline __m512i CounterHashx16(uint32_t key, uint32_t first) {
-  const __m512i counter =
-      _mm512_add_epi32(_mm512_set1_epi32(static_cast<int>(first)),
-                       _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15));
-  return Mix32x16(_mm512_xor_si512(
-      _mm512_mullo_epi32(counter, _mm512_set1_epi32(static_cast<int>(0x9E3779B9u))),
-      _mm512_set1_epi32(static_cast<int>(key))));
+  return CounterHashx16(key, ScrambledCounters(first));
 }
 MMH_AVX512 inline __m512 Floorx16(__m512 x) {
   return _mm512_roundscale_ps(x, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
@@ -574,11 +603,12 @@ MMH_AVX512 void DepthNoiseAvx512(const DepthParams& q, uint32_t first_pixel, int
   if (i == 1 && n > 0) DepthNoisePortable(q, first_pixel, 1, drop_bits, normal);
   for (; i + 32 <= n; i += 32) {
     const uint32_t pair = (first_pixel + static_cast<uint32_t>(i)) >> 1;
+    const __m512i counters = ScrambledCounters(pair);
     __m512 c, s;
-    BoxMullerx16(CounterHashx16(q.key_c, pair), &c, &s);
+    BoxMullerx16(CounterHashx16(q.key_c, counters), &c, &s);
     _mm512_storeu_ps(normal + i, _mm512_permutex2var_ps(c, first_half, s));
     _mm512_storeu_ps(normal + i + 16, _mm512_permutex2var_ps(c, second_half, s));
-    const __m512i h = CounterHashx16(q.key_b, pair);
+    const __m512i h = CounterHashx16(q.key_b, counters);
     const __m512i low = _mm512_and_si512(h, _mm512_set1_epi32(0xffff));
     const __m512i high = _mm512_srli_epi32(h, 16);
     _mm512_storeu_si512(drop_bits + i, _mm512_permutex2var_epi32(low, first_half, high));
@@ -589,14 +619,14 @@ MMH_AVX512 void DepthNoiseAvx512(const DepthParams& q, uint32_t first_pixel, int
   }
 }
 
-// Pixels i .. i + 15 of DepthRowPortable; `last`: pixel i + 15 ends the row (its right
-// neighbour counts as equal).
+// Pixels i .. i + 15 of DepthRowPortable, with their edge flags as bits i .. i + 15 of edge_bits
+// (ORed in); `last`: pixel i + 15 ends the row (its right neighbour counts as equal).
 template <bool kQuantise>
 MMH_AVX512 inline void DepthBlockAvx512(const DepthParams& q, const float* up, const float* row,
                                         const float* down, const float* depth,
                                         const float* cos_incidence, const uint8_t* occluded,
                                         const uint32_t* drop_bits, const float* normal, int i,
-                                        bool last, uint8_t* edge, uint16_t* out) {
+                                        bool last, uint64_t* edge_bits, uint16_t* out) {
   const __m512 zero = _mm512_setzero_ps();
   const __m512 half = Set(0.5f);
   const __m512 d = _mm512_loadu_ps(row + i);
@@ -610,8 +640,7 @@ MMH_AVX512 inline void DepthBlockAvx512(const DepthParams& q, const float* up, c
   const __mmask16 keep = _mm512_cmp_ps_mask(d, zero, _CMP_NEQ_UQ) &
                          _mm512_cmpeq_epi32_mask(occ, _mm512_setzero_si512());
   const __mmask16 is_edge = keep & _mm512_cmp_ps_mask(jump, Set(q.edge_jump), _CMP_GT_OQ);
-  _mm_storeu_si128(reinterpret_cast<__m128i*>(edge + i),
-                   _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(is_edge, 1)));
+  SetEdgeBits(edge_bits, i, is_edge);
   const __m512 g = _mm512_loadu_ps(normal + i);
   // DepthSample, lane-parallel.
   __m512i step = _mm512_cvttps_epi32(
@@ -650,28 +679,32 @@ MMH_AVX512 inline void DepthBlockAvx512(const DepthParams& q, const float* up, c
                       _mm512_cvtepi32_epi16(_mm512_cvttps_epi32(units)));
 }
 
+// A row of DepthBlockAvx512; edge: #n scratch for the portable code; edge_bits: zeroed.
 template <bool kQuantise>
 MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const float* row,
                                const float* down, const float* depth, const float* cos_incidence,
                                const uint8_t* occluded, const uint32_t* drop_bits,
-                               const float* normal, int n, uint8_t* edge, uint16_t* out) {
+                               const float* normal, int n, uint8_t* edge, uint64_t* edge_bits,
+                               uint16_t* out) {
   if (n < 17) {
     DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
                                 0, n, edge, out);
+    PackEdgeBits(edge, 0, n, edge_bits);
     return;
   }
   // Pixel 0 (no left neighbour): the portable code.
   DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
                               0, 1, edge, out);
+  PackEdgeBits(edge, 0, 1, edge_bits);
   int i = 1;
   for (; i + 16 < n; i += 16) {
     DepthBlockAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
-                                i, false, edge, out);
+                                i, false, edge_bits, out);
   }
   // The last 16 pixels (again where they overlap the previous block: same values).
   if (i < n) {
     DepthBlockAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
-                                n - 16, true, edge, out);
+                                n - 16, true, edge_bits, out);
   }
 }
 
@@ -836,23 +869,26 @@ std::atomic<bool>& UseAvx512() {
   return use;
 }
 
-// One depth row: its random numbers (drop_bits, normal: #n scratch), then the pixels.
+// One depth row: its random numbers (drop_bits, normal: #n scratch), then the pixels, with the
+// edge flags as bits (edge_bits: #ceil(n / 64); edge: #n scratch).
 template <bool kQuantise>
 void DepthRow(const DepthParams& q, const float* up, const float* row, const float* down,
               const float* depth, const float* cos_incidence, const uint8_t* occluded,
-              uint32_t first_pixel, int n, uint8_t* edge, uint32_t* drop_bits, float* normal,
-              uint16_t* out) {
+              uint32_t first_pixel, int n, uint8_t* edge, uint64_t* edge_bits, uint32_t* drop_bits,
+              float* normal, uint16_t* out) {
+  std::fill_n(edge_bits, (n + 63) / 64, uint64_t{0});
 #if MMH_SENSOR_AVX512
   if (UseAvx512().load(std::memory_order_relaxed)) {
     DepthNoiseAvx512(q, first_pixel, n, drop_bits, normal);
     DepthRowAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
-                              n, edge, out);
+                              n, edge, edge_bits, out);
     return;
   }
 #endif
   DepthNoisePortable(q, first_pixel, n, drop_bits, normal);
   DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
                               0, n, edge, out);
+  PackEdgeBits(edge, 0, n, edge_bits);
 }
 
 void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
@@ -1127,57 +1163,62 @@ struct KinectSensor::Impl {
   // One row of the depth image: the vector part for every pixel, then, for edge pixels only,
   // the edge dropout and the lateral noise (an edge pixel takes the depth and incidence of its
   // neighbour across the largest jump).
+  // edge: #w scratch; edge_bits: #ceil(w / 64) scratch.
   template <bool kQuantise>
   static void NoisyDepthRow(const DepthParams& q, const Geometry& g, int v, int w, int h,
-                            uint8_t* edge, uint32_t* hash, float* normal, uint16_t* out) {
+                            uint8_t* edge, uint64_t* edge_bits, uint32_t* hash, float* normal,
+                            uint16_t* out) {
     const size_t row = static_cast<size_t>(v) * w;
     const float* d = &g.disparity[row];
     const float* up = v > 0 ? d - w : d;
     const float* down = v + 1 < h ? d + w : d;
     DepthRow<kQuantise>(q, up, d, down, &g.depth[row], &g.cos_incidence[row], &g.occluded[row],
-                        static_cast<uint32_t>(row), w, edge, hash, normal, out);
+                        static_cast<uint32_t>(row), w, edge, edge_bits, hash, normal, out);
     const float uniform = 1.0f / 65536.0f;
-    for (int u = 0; u < w; ++u) {
-      // Edges are rare: skip eight pixels at a time.
-      if (u % 8 == 0 && u + 8 <= w) {
-        uint64_t word;
-        std::memcpy(&word, edge + u, sizeof(word));
-        if (word == 0) {
-          u += 7;
-          continue;
-        }
+    // Edges are rare: only their bits are visited, in order.
+    for (int word = 0; word < (w + 63) / 64; ++word) {
+      for (uint64_t bits = edge_bits[word]; bits != 0; bits &= bits - 1) {
+        EdgePixel<kQuantise>(q, g, v, w, h, word * 64 + std::countr_zero(bits), uniform, hash,
+                             normal, out);
       }
-      if (!edge[u]) continue;
-      const uint32_t hash_a = CounterHash(q.key_a, static_cast<uint32_t>(row + u));
-      const float u_lateral = static_cast<float>(hash_a & 0xffffu) * uniform;
-      const float u_edge = static_cast<float>((hash_a >> 16) & 0xffffu) * uniform;
-      if (u_edge < q.edge_probability) {
-        out[u] = 0;
-        continue;
+    }
+  }
+
+  // The edge dropout and lateral noise of edge pixel u of row v (NoisyDepthRow).
+  template <bool kQuantise>
+  static void EdgePixel(const DepthParams& q, const Geometry& g, int v, int w, int h, int u,
+                        float uniform, const uint32_t* hash, const float* normal, uint16_t* out) {
+    const size_t row = static_cast<size_t>(v) * w;
+    const float* d = &g.disparity[row];
+    const uint32_t hash_a = CounterHash(q.key_a, static_cast<uint32_t>(row + u));
+    const float u_lateral = static_cast<float>(hash_a & 0xffffu) * uniform;
+    const float u_edge = static_cast<float>((hash_a >> 16) & 0xffffu) * uniform;
+    if (u_edge < q.edge_probability) {
+      out[u] = 0;
+      return;
+    }
+    const size_t p = row + u;
+    // The neighbour across the largest jump.
+    size_t across = p;
+    float largest = -1.0f;
+    auto consider = [&](bool inside, size_t n) {
+      if (!inside) return;
+      const float j = std::abs(g.disparity[n] - d[u]);
+      if (j > largest) {
+        largest = j;
+        across = n;
       }
-      const size_t p = row + u;
-      // The neighbour across the largest jump.
-      size_t across = p;
-      float largest = -1.0f;
-      auto consider = [&](bool inside, size_t n) {
-        if (!inside) return;
-        const float j = std::abs(g.disparity[n] - d[u]);
-        if (j > largest) {
-          largest = j;
-          across = n;
-        }
-      };
-      consider(u > 0, p - 1);
-      consider(u + 1 < w, p + 1);
-      consider(v > 0, p - w);
-      consider(v + 1 < h, p + w);
-      // Lateral noise: the edge moves by the rounded N(0, sigma_L) offset; towards the neighbour
-      // across the edge in half of the cases where it rounds to one pixel or more.
-      if (u_lateral < q.lateral_cross[CosStep(g.cos_incidence[p])] &&
-          std::isfinite(g.depth[across])) {
-        out[u] = DepthSample<kQuantise>(q, g.depth[across], g.cos_incidence[across], true, hash[u],
-                                        normal[u]);
-      }
+    };
+    consider(u > 0, p - 1);
+    consider(u + 1 < w, p + 1);
+    consider(v > 0, p - w);
+    consider(v + 1 < h, p + w);
+    // Lateral noise: the edge moves by the rounded N(0, sigma_L) offset; towards the neighbour
+    // across the edge in half of the cases where it rounds to one pixel or more.
+    if (u_lateral < q.lateral_cross[CosStep(g.cos_incidence[p])] &&
+        std::isfinite(g.depth[across])) {
+      out[u] = DepthSample<kQuantise>(q, g.depth[across], g.cos_incidence[across], true, hash[u],
+                                      normal[u]);
     }
   }
 
@@ -1446,6 +1487,7 @@ struct KinectSensor::Impl {
     const int rows = std::max(dh, ch);
     tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& r) {
       std::vector<uint8_t> edge(dw);
+      std::vector<uint64_t> edge_bits((dw + 63) / 64);
       std::vector<uint32_t> hash(dw);
       std::vector<float> normal(dw);
       for (int v = r.begin(); v != r.end(); ++v) {
@@ -1454,11 +1496,11 @@ struct KinectSensor::Impl {
           if (!q.noise) {
             ExactDepthRow(q, dv.current, v, dw, out);
           } else if (q.quantise) {
-            NoisyDepthRow<true>(q, dv.current, v, dw, dh, edge.data(), hash.data(), normal.data(),
-                                out);
+            NoisyDepthRow<true>(q, dv.current, v, dw, dh, edge.data(), edge_bits.data(),
+                                hash.data(), normal.data(), out);
           } else {
-            NoisyDepthRow<false>(q, dv.current, v, dw, dh, edge.data(), hash.data(), normal.data(),
-                                 out);
+            NoisyDepthRow<false>(q, dv.current, v, dw, dh, edge.data(), edge_bits.data(),
+                                 hash.data(), normal.data(), out);
           }
         }
         if (v < ch) {
