@@ -56,16 +56,33 @@ double LinearToSrgb(double c) {
 constexpr int kEncodeSteps = 4096;
 
 // The union of row intervals (overlapping or touching ones merged), ordered by row and column.
-std::vector<PixelSpan> MergeRowIntervals(std::vector<PixelSpan> intervals) {
-  std::sort(intervals.begin(), intervals.end(), [](const PixelSpan& x, const PixelSpan& y) {
-    return x.row < y.row || (x.row == y.row && x.first < y.first);
-  });
+// Rows are few (an image's height), so the intervals are bucketed by row (a counting sort) and
+// only each row's handful is sorted by column.
+std::vector<PixelSpan> MergeRowIntervals(const std::vector<PixelSpan>& intervals) {
   std::vector<PixelSpan> spans;
+  if (intervals.empty()) return spans;
+  int row_min = intervals.front().row, row_max = row_min;
   for (const PixelSpan& s : intervals) {
-    if (!spans.empty() && spans.back().row == s.row && s.first <= spans.back().last + 1) {
-      spans.back().last = std::max(spans.back().last, s.last);
-    } else {
-      spans.push_back(s);
+    row_min = std::min(row_min, s.row);
+    row_max = std::max(row_max, s.row);
+  }
+  std::vector<int> start(static_cast<size_t>(row_max - row_min) + 2, 0);
+  for (const PixelSpan& s : intervals) ++start[s.row - row_min + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<PixelSpan> by_row(intervals.size());
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (const PixelSpan& s : intervals) by_row[next[s.row - row_min]++] = s;
+  for (size_t r = 0; r + 1 < start.size(); ++r) {
+    const auto first = by_row.begin() + start[r], last = by_row.begin() + start[r + 1];
+    std::sort(first, last,
+              [](const PixelSpan& x, const PixelSpan& y) { return x.first < y.first; });
+    const size_t row_begin = spans.size();
+    for (auto it = first; it != last; ++it) {
+      if (spans.size() > row_begin && it->first <= spans.back().last + 1) {
+        spans.back().last = std::max(spans.back().last, it->last);
+      } else {
+        spans.push_back(*it);
+      }
     }
   }
   return spans;
@@ -131,34 +148,41 @@ void CoverConvexPolygon(const std::vector<Eigen::Vector2d>& polygon, int width, 
   }
   const int v0 = std::max(0, static_cast<int>(std::ceil(y_min - kCoverMargin)));
   const int v1 = std::min(height - 1, static_cast<int>(std::floor(y_max + kCoverMargin)));
+  if (v0 > v1) return;
+  // Per row v the x extent of the polygon within the band [v - margin, v + margin]: each edge
+  // contributes its x at the ends of its part inside the band (x linear in y along the edge; the
+  // slope is computed once per edge, not once per row).
   const size_t n = polygon.size();
-  for (int v = v0; v <= v1; ++v) {
-    const double lo = v - kCoverMargin, hi = v + kCoverMargin;
-    double x_min = 1e300, x_max = -1e300;
-    for (size_t i = 0; i < n; ++i) {
-      const Eigen::Vector2d& a = polygon[i];
-      const Eigen::Vector2d& b = polygon[(i + 1) % n];
-      // The part of edge ab inside the band.
-      double t0 = 0.0, t1 = 1.0;
-      const double dy = b.y() - a.y();
+  std::vector<double> x_min(v1 - v0 + 1, 1e300), x_max(v1 - v0 + 1, -1e300);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[(i + 1) % n];
+    const double dy = b.y() - a.y();
+    const double edge_y_min = std::min(a.y(), b.y()), edge_y_max = std::max(a.y(), b.y());
+    const int first = std::max(v0, static_cast<int>(std::ceil(edge_y_min - kCoverMargin)));
+    const int last = std::min(v1, static_cast<int>(std::floor(edge_y_max + kCoverMargin)));
+    const double slope = dy == 0.0 ? 0.0 : (b.x() - a.x()) / dy;
+    for (int v = first; v <= last; ++v) {
+      double xa, xb;
       if (dy == 0.0) {
-        if (a.y() < lo || a.y() > hi) continue;
+        xa = a.x();
+        xb = b.x();
       } else {
-        double ta = (lo - a.y()) / dy, tb = (hi - a.y()) / dy;
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-        if (t0 > t1) continue;
+        const double lo = std::max(edge_y_min, v - kCoverMargin);
+        const double hi = std::min(edge_y_max, v + kCoverMargin);
+        xa = a.x() + (lo - a.y()) * slope;
+        xb = a.x() + (hi - a.y()) * slope;
       }
-      for (double t : {t0, t1}) {
-        const double x = a.x() + t * (b.x() - a.x());
-        x_min = std::min(x_min, x);
-        x_max = std::max(x_max, x);
-      }
+      double& row_min = x_min[v - v0];
+      double& row_max = x_max[v - v0];
+      row_min = std::min({row_min, xa, xb});
+      row_max = std::max({row_max, xa, xb});
     }
-    if (x_min > x_max) continue;
-    const int u0 = std::max(0, static_cast<int>(std::ceil(x_min - kCoverMargin)));
-    const int u1 = std::min(width - 1, static_cast<int>(std::floor(x_max + kCoverMargin)));
+  }
+  for (int v = v0; v <= v1; ++v) {
+    if (x_min[v - v0] > x_max[v - v0]) continue;
+    const int u0 = std::max(0, static_cast<int>(std::ceil(x_min[v - v0] - kCoverMargin)));
+    const int u1 = std::min(width - 1, static_cast<int>(std::floor(x_max[v - v0] + kCoverMargin)));
     if (u0 > u1) continue;
     rows->push_back({v, u0, u1});
   }
@@ -1341,7 +1365,7 @@ struct KinectSensor::Impl {
       union_rows.insert(union_rows.end(), object.spans.begin(), object.spans.end());
       if (!object.spans.empty()) result.push_back(std::move(object));
     }
-    *all = MergeRowIntervals(std::move(union_rows));
+    *all = MergeRowIntervals(union_rows);
     return result;
   }
 
