@@ -45,6 +45,10 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   }
   RequireNonNegative(switch_margin, prefix + ".switch_margin");
   RequireNonNegative(far_switch_margin, prefix + ".far_switch_margin");
+  RequireNonNegative(rival_drift, prefix + ".rival_drift");
+  RequireNonNegative(seed_shift, prefix + ".seed_shift", "m");
+  RequireNonNegative(seed_turn_deg, prefix + ".seed_turn_deg", "deg");
+  RequireNonNegative(rival_threshold, prefix + ".rival_threshold");
   if (trusted_frames < 0) {
     ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
   }
@@ -344,19 +348,16 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   };
   // Candidates are refined and ranked on at most refine_points segmented points (and the skin
   // points among data_ in proportion); only the winner is refined on all of them.
-  std::vector<Eigen::Vector3f>& medium = detection_scratch_;
-  medium.clear();
-  const size_t medium_stride =
-      std::max<size_t>(1, (scored_ + o.refine_points - 1) / static_cast<size_t>(o.refine_points));
-  for (size_t i = 0; i < scored_; i += medium_stride) medium.push_back(data_[i]);
-  const size_t medium_scored = medium.size();
-  for (size_t i = scored_; i < data_.size(); i += medium_stride) medium.push_back(data_[i]);
+  const size_t medium_scored = PrepareMediumData();
+  const std::vector<Eigen::Vector3f>& medium = detection_scratch_;
   auto refine = [&](const Rigid3& proxy_T_camera, const IcpOptions& icp) {
     return AlignPointToPlane(*model_, medium, medium_scored, options_.verification.skin_distance,
                              proxy_T_camera, icp, sample_matches_);
   };
   std::vector<Rigid3> refined_poses;
   std::optional<Candidate> best;
+  // The verified poses (proxy_T_camera) and their scores, for the rival below.
+  std::vector<std::pair<Rigid3, double>> verified;
   // The motion model's poses are candidates too (the prediction and the last measured pose),
   // refined as the twins are: the coarse hypotheses sample yaw every 30 deg, and when a
   // near-symmetric twin scores as well as the truth (its distinguishing part under the hand), only
@@ -366,6 +367,24 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   if (last_ && (!predicted || !(last_->rotation.isApprox(predicted->rotation) &&
                                 last_->translation.isApprox(predicted->translation)))) {
     seeds.push_back(*last_);
+  }
+  // ... and the prediction displaced: the tracked pose may sit in a nearby minimum the ICP cannot
+  // leave (seen from the side under the hand, the figure slides along its vertical faces, or rolls
+  // a few degrees), which the coarse hypotheses, 30 deg apart, need not reach either.
+  if (predicted && o.seed_shift > 0) {
+    const Eigen::Vector3d up = camera_R_table * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d center = *predicted * model_->center().cast<double>();
+    for (double sign : {-1.0, 1.0}) {
+      seeds.emplace_back(predicted->rotation, predicted->translation + sign * o.seed_shift * up);
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+      for (double sign : {-1.0, 1.0}) {
+        const Eigen::Quaterniond turn(Eigen::AngleAxisd(
+            sign * o.seed_turn_deg * pi / 180, camera_R_table * Eigen::Vector3d::Unit(axis)));
+        seeds.emplace_back(turn * predicted->rotation,
+                           center + turn * (predicted->translation - center));
+      }
+    }
   }
   for (const Rigid3& seed : seeds) {
     const IcpResult coarse_seed = refine(seed.Inverse(), coarse_icp);
@@ -377,6 +396,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
     refined_poses.push_back(refined.proxy_T_camera);
     Candidate candidate = Verify(frame, refined);
     if (better(candidate, best)) best = candidate;
+    if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
   }
   const size_t seeded = refined_poses.size();
   for (size_t c = 0;
@@ -391,6 +411,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
     refined_poses.push_back(refined.proxy_T_camera);
     Candidate candidate = Verify(frame, refined);
     if (better(candidate, best)) best = candidate;
+    if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
   }
   // Near-symmetric twins of the best pose: turned by quarter turns about the model's own axes
   // through its centre (a proxy built from bricks is often symmetric but for a small part, which
@@ -411,6 +432,8 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
         if (same_pose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
         Candidate candidate = Verify(frame, refined);
         if (better(candidate, best)) best = candidate;
+        if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
+        if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
       }
     }
   }
@@ -418,6 +441,19 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
     best = Verify(frame,
                   AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
                                     best->icp.proxy_T_camera, search_icp_, sample_matches_));
+    // The rival: the best-scoring verified pose more than 45 deg from the winner (a near-symmetric
+    // twin that the data could not rule out), kept as the turn from the winner in the model's
+    // frame (proxy_T_rival) and carried along with the track (Track: the twin evidence).
+    const Rigid3 camera_T_best = best->icp.proxy_T_camera.Inverse();
+    detection_rival_.reset();
+    double rival_score = 0.0;
+    for (const auto& [proxy_T_camera, score] : verified) {
+      const Rigid3 camera_T_pose = proxy_T_camera.Inverse();
+      if (RotationAngle(camera_T_pose.rotation, camera_T_best.rotation) <= pi / 4) continue;
+      if (detection_rival_ && score <= rival_score) continue;
+      detection_rival_ = camera_T_best.Inverse() * camera_T_pose;
+      rival_score = score;
+    }
   }
   return best;
 }
@@ -438,6 +474,17 @@ ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
   score.score = candidate.Score();
   score.good = candidate.good;
   return score;
+}
+
+size_t ProxyTracker::PrepareMediumData() {
+  const size_t refine_points = static_cast<size_t>(options_.detection.refine_points);
+  std::vector<Eigen::Vector3f>& medium = detection_scratch_;
+  medium.clear();
+  const size_t stride = std::max<size_t>(1, (scored_ + refine_points - 1) / refine_points);
+  for (size_t i = 0; i < scored_; i += stride) medium.push_back(data_[i]);
+  const size_t medium_scored = medium.size();
+  for (size_t i = scored_; i < data_.size(); i += stride) medium.push_back(data_[i]);
+  return medium_scored;
 }
 
 void ProxyTracker::PrepareData() {
@@ -465,6 +512,61 @@ void ProxyTracker::PrepareData() {
   }
 }
 
+void ProxyTracker::SetRival(const std::optional<Rigid3>& proxy_T_rival, bool reset_evidence) {
+  if (!proxy_T_rival) {
+    // No rival found: a structural twin stays one (keep the old one) unless the track restarts.
+    if (reset_evidence) {
+      proxy_T_rival_.reset();
+      rival_evidence_ = 0.0;
+    }
+    return;
+  }
+  // Evidence against one twin says nothing about another.
+  if (reset_evidence || !proxy_T_rival_ ||
+      RotationAngle(proxy_T_rival_->rotation, proxy_T_rival->rotation) > std::numbers::pi / 4) {
+    rival_evidence_ = 0.0;
+  }
+  proxy_T_rival_ = proxy_T_rival;
+}
+
+bool ProxyTracker::WeighRival(const RgbdFrame& frame, Candidate* chosen) {
+  const DetectionOptions& o = options_.detection;
+  if (o.rival_threshold <= 0 || !proxy_T_rival_ || !chosen->good) return false;
+  const double pi = std::numbers::pi;
+  const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
+  const Rigid3 camera_T_rival = camera_T_proxy * *proxy_T_rival_;
+  // Refined on the detection's subsample, then scored on all of this frame's data (as the
+  // tracked pose is).
+  const size_t medium_scored = PrepareMediumData();
+  const double skin = options_.verification.skin_distance;
+  const IcpResult coarse =
+      AlignPointToPlane(*model_, detection_scratch_, medium_scored, skin, camera_T_rival.Inverse(),
+                        search_icp_, sample_matches_);
+  IcpOptions final_icp = search_icp_;
+  final_icp.max_iterations = 2;
+  final_icp.start_distance = final_icp.end_distance;
+  final_icp.shrink_iterations = 0;
+  const Candidate rival =
+      Verify(frame, AlignPointToPlane(*model_, data_, scored_, skin, coarse.proxy_T_camera,
+                                      final_icp, sample_matches_));
+  const Rigid3 camera_T_refined = rival.icp.proxy_T_camera.Inverse();
+  // Slid back onto the tracked pose: no twin here (this frame says nothing).
+  if (RotationAngle(camera_T_refined.rotation, camera_T_proxy.rotation) <= pi / 4) return false;
+  const double difference = rival.good ? rival.Score() - chosen->Score() : -o.rival_drift;
+  rival_evidence_ = std::max(0.0, rival_evidence_ + difference - o.rival_drift);
+  if (!rival.good) return false;
+  if (rival_evidence_ <= o.rival_threshold) {
+    proxy_T_rival_ = camera_T_proxy.Inverse() * camera_T_refined;
+    return false;
+  }
+  // The rival has explained the data better for long enough: it is the pose, the old one its
+  // rival.
+  proxy_T_rival_ = camera_T_refined.Inverse() * camera_T_proxy;
+  rival_evidence_ = 0.0;
+  *chosen = rival;
+  return true;
+}
+
 TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   const double pi = std::numbers::pi;
   TrackFrameResult result;
@@ -477,6 +579,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     velocity_.reset();
     predicted_frames_ = 0;
     tracked_frames_ = 0;
+    SetRival(std::nullopt, true);
     return result;
   };
   // The frame itself.
@@ -561,18 +664,25 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
                                      chosen->icp.proxy_T_camera, options_.icp, sample_matches_));
       }
       std::optional<Candidate> detected = Detect(frame, predicted);
+      const bool far = detected && RotationAngle(detected->icp.proxy_T_camera.rotation,
+                                                 chosen->icp.proxy_T_camera.rotation) > pi / 4;
       if (detected && detected->good &&
           (!chosen->good ||
-           detected->Score() >
-               chosen->Score() + (RotationAngle(detected->icp.proxy_T_camera.rotation,
-                                                chosen->icp.proxy_T_camera.rotation) > pi / 4
-                                      ? d.far_switch_margin
-                                      : d.switch_margin))) {
+           detected->Score() > chosen->Score() + (far ? d.far_switch_margin : d.switch_margin))) {
         chosen = detected;
         result.detected = true;
+        SetRival(detection_rival_, far);
       } else if (!chosen->good) {
         why = chosen->reason;
         chosen.reset();
+      } else if (detected && detected->good && far) {
+        // The tracked pose stays; the detection's pose is its rival.
+        SetRival(chosen->icp.proxy_T_camera * detected->icp.proxy_T_camera.Inverse(), false);
+      } else if (detected && detection_rival_) {
+        // The detection agrees with the track: its rival, turned onto the tracked pose.
+        SetRival(
+            chosen->icp.proxy_T_camera * detected->icp.proxy_T_camera.Inverse() * *detection_rival_,
+            false);
       }
     }
   }
@@ -584,11 +694,13 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     if (detected && detected->good) {
       chosen = detected;
       result.detected = true;
+      SetRival(detection_rival_, true);
     } else if (why.empty()) {
       why = detected ? "no pose hypothesis verified (best: " + detected->reason + ")"
                      : "no segment large enough for a detection";
     }
   }
+  if (chosen && WeighRival(frame, &*chosen)) result.detected = true;
   if (chosen) {
     const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
     if (last_ && !result.detected) {

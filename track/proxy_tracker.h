@@ -65,6 +65,20 @@ struct DetectionOptions {
   // measured for trusted_frames frames since its last loss (before that, a fresh detection may
   // still have picked a near-symmetric twin: switch_margin decides).
   int trusted_frames = 30;
+  // Twin evidence (CUSUM, Page 1954): the best verified pose of the last detection that lies more
+  // than 45 deg from its winner (the rival: a near-symmetric twin) is carried along with the track
+  // and refined on every tracked frame; its score's excess over the tracked pose's, less
+  // rival_drift, is summed (never below 0), and when the sum exceeds rival_threshold the rival
+  // becomes the pose (0: off). A twin that explains the data a little better on many frames wins,
+  // where one margin per check (far_switch_margin) either waits for a large difference or switches
+  // on noise.
+  // Besides the prediction and the last pose, the prediction shifted by +-seed_shift [m] along the
+  // table's normal and turned by +-seed_turn_deg [deg] about the table's x and y axes through the
+  // model's centre are refined as candidates (0: not).
+  double seed_shift = 0.012;
+  double seed_turn_deg = 10.0;
+  double rival_drift = 0.03;
+  double rival_threshold = 0.25;
 
   template <class V>
   void VisitFields(V& v) {
@@ -84,6 +98,10 @@ struct DetectionOptions {
     v("switch_margin", switch_margin);
     v("far_switch_margin", far_switch_margin);
     v("trusted_frames", trusted_frames);
+    v("seed_shift", seed_shift);
+    v("seed_turn_deg", seed_turn_deg);
+    v("rival_drift", rival_drift);
+    v("rival_threshold", rival_threshold);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -218,6 +236,16 @@ class ProxyTracker {
   bool EnsureTable(const RgbdFrame& frame, std::string* why);
   // data_ and scored_ from segmentation_.
   void PrepareData();
+  // detection_scratch_: data_ subsampled to about refine_points scored points (and the extra
+  // points in proportion); returns how many are scored.
+  size_t PrepareMediumData();
+  // The twin evidence (DetectionOptions::rival_threshold): sets the rival (nullopt: keeps the old
+  // one, or forgets it when reset_evidence), resetting the evidence when asked or when it is
+  // another twin.
+  void SetRival(const std::optional<Rigid3>& proxy_T_rival, bool reset_evidence);
+  // Refines the rival on this frame, adds its evidence, and replaces *chosen by it when the
+  // evidence suffices (returns true then).
+  bool WeighRival(const RgbdFrame& frame, Candidate* chosen);
   // The global detection; `predicted` (the motion model's pose, when there is one) breaks ties.
   std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted);
   Candidate Verify(const RgbdFrame& frame, const IcpResult& icp) const;
@@ -252,6 +280,11 @@ class ProxyTracker {
   std::vector<Eigen::Vector3f> detection_scratch_;
   // Per model sample: which data it may match (kMatchesScored | kMatchesExtra); empty: all.
   std::vector<uint8_t> sample_matches_;
+  // The rival of the tracked pose (proxy_T_rival, in the proxy's frame), the rival the last
+  // detection found (proxy_T_rival relative to its winner) and the evidence for it.
+  std::optional<Rigid3> proxy_T_rival_;
+  std::optional<Rigid3> detection_rival_;
+  double rival_evidence_ = 0.0;
   // options_.icp without the motion prior (detection, scoring).
   IcpOptions search_icp_;
   size_t scored_ = 0;

@@ -199,10 +199,15 @@ TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
     ProxyTracker tracker(take.model(), "soldier", take.Setup(),
                          config.Get<ProxyTrackerOptions>("tracker"));
     int ok = 0;
+    std::vector<std::optional<Rigid3>> estimates;
+    std::vector<Rigid3> truths;
     for (int i = first; i < first + frames; ++i) {
       Rigid3 truth;
       const RgbdFrame frame = take.Render(i, &truth);
       const TrackFrameResult r = tracker.Track(frame);
+      truths.push_back(truth);
+      estimates.push_back(r.status != TrackStatus::kLost ? std::optional(r.camera_T_proxy)
+                                                         : std::nullopt);
       const double rot = RotationAngle(r.camera_T_proxy.rotation, truth.rotation) * 180 / M_PI;
       const double trans = (r.camera_T_proxy.translation - truth.translation).norm();
       const bool success = r.status != TrackStatus::kLost && rot < 5 && trans < 0.01;
@@ -274,6 +279,14 @@ TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
           at_truth.inlier_share, at_truth.free_space_violation, at_truth.good, r.reason.c_str());
     }
     std::printf("== success %.4f (%d of %d)\n", static_cast<double>(ok) / frames, ok, frames);
+    const auto points = metrics::MetricPoints(take.model());
+    const metrics::PoseErrorOptions metric_options;
+    const metrics::TrackingSummary summary = metrics::SummarizeTracking(
+        metrics::ComputePoseErrors(estimates, truths, points, metric_options),
+        metrics::Diameter(points), metric_options);
+    std::printf("== summary %d:%d success %.4f median %.2f deg %.2f mm longest %d recovered %d\n",
+                animator, take_index, summary.success_rate, summary.median_rotation_deg,
+                summary.median_translation * 1000, summary.longest_failure, summary.all_recovered);
   }
 }
 
