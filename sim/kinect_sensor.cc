@@ -876,9 +876,106 @@ MMH_AVX512 void OcclusionScanAvx512(const float* us, int n, uint8_t* occluded) {
     carry = Extremum<kFromRight>(carry, Set(block_extremum));
   }
 }
+
+// OcclusionWindowPortable (below), 16 pixels at a time.
+template <bool kFromRight>
+MMH_AVX512 int OcclusionWindowAvx512(const float* us, const float* cached, int n, int first,
+                                     int last, uint8_t* flags) {
+  const float infinity = std::numeric_limits<float>::infinity();
+  const __m512 none = Set(kFromRight ? infinity : -infinity);
+  const int direction = kFromRight ? 1 : -1;
+  int block = (kFromRight ? last : first) / 16;
+  float carry_value;
+  if constexpr (kFromRight) {
+    carry_value = (block + 1) * 16 < n ? cached[(block + 1) * 16] : infinity;
+  } else {
+    carry_value = block > 0 ? cached[16 * block - 1] : -infinity;
+  }
+  __m512 carry = Set(carry_value);
+  for (; kFromRight ? block >= 0 : block < n / 16; block += kFromRight ? -1 : 1) {
+    const int i = 16 * block;
+    const __m512 x = _mm512_loadu_ps(us + i);
+    __m512 m = ShiftLanes(x, none, direction);
+    for (int k : {1, 2, 4, 8}) m = Extremum<kFromRight>(m, ShiftLanes(m, none, direction * k));
+    const __m512 bound = Extremum<kFromRight>(m, carry);
+    const __mmask16 hidden = _mm512_cmp_ps_mask(x, bound, kFromRight ? _CMP_GE_OQ : _CMP_LE_OQ);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(flags + i),
+                     _mm512_cvtepi32_epi8(_mm512_maskz_set1_epi32(hidden, 1)));
+    carry_value = kFromRight ? std::min(carry_value, _mm512_reduce_min_ps(x))
+                             : std::max(carry_value, _mm512_reduce_max_ps(x));
+    carry = Set(carry_value);
+    if constexpr (kFromRight) {
+      if (i <= first && carry_value == cached[i]) return i;
+    } else {
+      if (i + 15 >= last && carry_value == cached[i + 15]) return i + 15;
+    }
+  }
+  return kFromRight ? 0 : n - 1;
+}
 #undef MMH_AVX512
 #pragma GCC diagnostic pop
 #endif  // MMH_SENSOR_AVX512
+
+// The occlusion flags of one source over the part of a row that a change in columns
+// [first, last] can affect (incremental frames), given the row's scan values now (us, #n, n a
+// multiple of 16, padded with the source's `none`) and the inclusive extrema of the static
+// scene's scan values (cached: from the right, cached[u] = min of us_static over u' >= u; from
+// the left, max over u' <= u). Outside [first, last] the row equals the static scene, so the
+// scan can start at the change with the cached extremum as its carry, and it can stop once its
+// running extremum equals the cached one again beyond the change: from there on every pixel sees
+// the same values as in the static scene and keeps its cached flag. Writes flags[u] for u in the
+// window and returns the window's far end (from the right: its first pixel, from the left: its
+// last; the near end is the start of the block holding `last` (`first`)). Blocks of 16 pixels,
+// as the vector kernel (same window, same flags).
+template <bool kFromRight>
+int OcclusionWindowPortable(const float* us, const float* cached, int n, int first, int last,
+                            uint8_t* flags) {
+  const float infinity = std::numeric_limits<float>::infinity();
+  int block = (kFromRight ? last : first) / 16;
+  float carry;
+  if constexpr (kFromRight) {
+    carry = (block + 1) * 16 < n ? cached[(block + 1) * 16] : infinity;
+  } else {
+    carry = block > 0 ? cached[16 * block - 1] : -infinity;
+  }
+  for (; kFromRight ? block >= 0 : block < n / 16; block += kFromRight ? -1 : 1) {
+    const int i = 16 * block;
+    if constexpr (kFromRight) {
+      for (int u = i + 15; u >= i; --u) {
+        flags[u] = static_cast<uint8_t>(us[u] >= carry);
+        carry = std::min(carry, us[u]);
+      }
+      if (i <= first && carry == cached[i]) return i;
+    } else {
+      for (int u = i; u < i + 16; ++u) {
+        flags[u] = static_cast<uint8_t>(us[u] <= carry);
+        carry = std::max(carry, us[u]);
+      }
+      if (i + 15 >= last && carry == cached[i + 15]) return i + 15;
+    }
+  }
+  return kFromRight ? 0 : n - 1;
+}
+
+// The flags and inclusive extrema of a whole row's scan for one source (the static scene's, for
+// OcclusionWindowPortable): the same flags as the full scans of OccludeRow.
+void OcclusionCacheRow(const float* us, int n, bool from_right, float* extremum, uint8_t* flags) {
+  if (from_right) {
+    float lowest = std::numeric_limits<float>::infinity();
+    for (int u = n - 1; u >= 0; --u) {
+      flags[u] = static_cast<uint8_t>(us[u] >= lowest);
+      lowest = std::min(lowest, us[u]);
+      extremum[u] = lowest;
+    }
+  } else {
+    float highest = -std::numeric_limits<float>::infinity();
+    for (int u = 0; u < n; ++u) {
+      flags[u] = static_cast<uint8_t>(us[u] <= highest);
+      highest = std::max(highest, us[u]);
+      extremum[u] = highest;
+    }
+  }
+}
 
 bool UseAvx512Default() {
 #if MMH_SENSOR_AVX512
@@ -1035,6 +1132,13 @@ struct KinectSensor::Impl {
     bool cached = false;
     bool all_dirty = false;  // the working buffers differ from the cache anywhere
     std::vector<PixelSpan> dirty;
+    // Per occluder source, the static scene's scan (OcclusionCacheRow): inclusive extrema and
+    // flags, #height by padded width (a multiple of 16).
+    std::vector<std::vector<float>> source_extremum;
+    std::vector<std::vector<uint8_t>> source_flags;
+    // Per row, the columns [first, last] whose occlusion flags the last frame wrote (first > last:
+    // none); they get the cached flags back before the row's next windowed scan.
+    std::vector<PixelSpan> occlusion_written;
   };
 
   // The cast's write-back: keeps only what the model needs (depth, disparity, incidence cosine)
@@ -1272,6 +1376,8 @@ struct KinectSensor::Impl {
     const int width = view.intrinsics.width;
     Geometry& g = view.current;
     const double fx = view.intrinsics.fx;
+    view.occlusion_written.resize(view.intrinsics.height);
+    for (int v : rows) view.occlusion_written[v] = {v, 0, width - 1};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 16),
                       [&](const tbb::blocked_range<size_t>& r) {
                         std::vector<float> us(width + 16);
@@ -1282,6 +1388,120 @@ struct KinectSensor::Impl {
                                      scan.data(), &g.occluded[row]);
                         }
                       });
+  }
+
+  // The scan values of one row for source_x (see Occlude), padded with the source's `none` to a
+  // multiple of 16 (us: scratch of at least width + 16 entries); returns the padded width.
+  int SourceRow(const float* disparity, int width, double fx, double source_x, float* us) const {
+    const int padded = (width + 15) / 16 * 16;
+    const auto shift = static_cast<float>(fx * source_x / disparity_scale);
+    // Pixels that see nothing never bound the scan.
+    const float none = (source_x > 0 ? 1.0f : -1.0f) * std::numeric_limits<float>::infinity();
+    SourceColumns(disparity, width, shift, none, us);
+    std::fill(us + width, us + padded, none);
+    return padded;
+  }
+
+  // The static scene's scans per source (view.cache must hold it), for OccludeWindows.
+  void CacheOcclusion(View& view) const {
+    if (!view.needs_occlusion) return;
+    const int width = view.intrinsics.width;
+    const int height = view.intrinsics.height;
+    const int padded = (width + 15) / 16 * 16;
+    const size_t sources = view.occluder_sources.size();
+    view.source_extremum.assign(sources, std::vector<float>(static_cast<size_t>(padded) * height));
+    view.source_flags.assign(sources, std::vector<uint8_t>(static_cast<size_t>(padded) * height));
+    std::vector<float> us(width + 16);
+    for (size_t k = 0; k < sources; ++k) {
+      const double source_x = view.occluder_sources[k];
+      for (int v = 0; v < height; ++v) {
+        SourceRow(&view.cache.disparity[static_cast<size_t>(v) * width], width, view.intrinsics.fx,
+                  source_x, us.data());
+        const size_t at = static_cast<size_t>(v) * padded;
+        OcclusionCacheRow(us.data(), padded, source_x > 0, &view.source_extremum[k][at],
+                          &view.source_flags[k][at]);
+      }
+    }
+  }
+
+  // Occlusion of an incremental frame: per row whose geometry differs from the static scene in
+  // columns [first, last] (this frame's or the last frame's moving objects), the cached flags
+  // back where the last frame wrote, then per source the scan over the window that the change
+  // can affect (OcclusionWindowPortable), cached flags elsewhere. Gives the flags of Occlude.
+  void OccludeWindows(View& view, std::span<const PixelSpan> changes) {
+    if (!view.needs_occlusion) return;
+    const int width = view.intrinsics.width;
+    const int padded = (width + 15) / 16 * 16;
+    Geometry& g = view.current;
+    const double fx = view.intrinsics.fx;
+    const bool vector = UseAvx512().load(std::memory_order_relaxed) && MMH_SENSOR_AVX512;
+    const size_t sources = view.occluder_sources.size();
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, changes.size(), 16),
+        [&](const tbb::blocked_range<size_t>& r) {
+          std::vector<float> us(width + 16);
+          std::vector<std::vector<uint8_t>> flags(sources, std::vector<uint8_t>(padded));
+          std::vector<PixelSpan> windows(sources);
+          for (size_t c = r.begin(); c != r.end(); ++c) {
+            const PixelSpan& change = changes[c];
+            const size_t row = static_cast<size_t>(change.row) * width;
+            const size_t cached_row = static_cast<size_t>(change.row) * padded;
+            PixelSpan& written = view.occlusion_written[change.row];
+            if (written.first <= written.last) {
+              std::copy(&view.cache.occluded[row + written.first],
+                        &view.cache.occluded[row + written.last] + 1,
+                        &g.occluded[row + written.first]);
+            }
+            int lo = change.first, hi = change.last;
+            for (size_t k = 0; k < sources; ++k) {
+              const double source_x = view.occluder_sources[k];
+              SourceRow(&g.disparity[row], width, fx, source_x, us.data());
+              const float* cached = &view.source_extremum[k][cached_row];
+              PixelSpan& w = windows[k];
+              if (source_x > 0) {
+                w.last = change.last / 16 * 16 + 15;
+#if MMH_SENSOR_AVX512
+                if (vector) {
+                  w.first = OcclusionWindowAvx512<true>(us.data(), cached, padded, change.first,
+                                                        change.last, flags[k].data());
+                } else
+#endif
+                {
+                  w.first = OcclusionWindowPortable<true>(us.data(), cached, padded, change.first,
+                                                          change.last, flags[k].data());
+                }
+              } else {
+                w.first = change.first / 16 * 16;
+#if MMH_SENSOR_AVX512
+                if (vector) {
+                  w.last = OcclusionWindowAvx512<false>(us.data(), cached, padded, change.first,
+                                                        change.last, flags[k].data());
+                } else
+#endif
+                {
+                  w.last = OcclusionWindowPortable<false>(us.data(), cached, padded, change.first,
+                                                          change.last, flags[k].data());
+                }
+              }
+              lo = std::min(lo, w.first);
+              hi = std::max(hi, w.last);
+            }
+            hi = std::min(hi, width - 1);
+            for (size_t k = 0; k < sources; ++k) {
+              const uint8_t* cached_flags = &view.source_flags[k][cached_row];
+              for (int u = lo; u < windows[k].first; ++u) flags[k][u] = cached_flags[u];
+              for (int u = windows[k].last + 1; u <= hi; ++u) flags[k][u] = cached_flags[u];
+            }
+            const float* d = &g.disparity[row];
+            uint8_t* occluded = &g.occluded[row];
+            for (int u = lo; u <= hi; ++u) {
+              uint8_t any = 0;
+              for (size_t k = 0; k < sources; ++k) any |= flags[k][u];
+              occluded[u] = static_cast<uint8_t>(any & static_cast<uint8_t>(d[u] != 0.0f));
+            }
+            written = {change.row, lo, hi};
+          }
+        });
   }
 
   // us and scan: scratch of at least width + 16 entries.
@@ -1408,6 +1628,7 @@ struct KinectSensor::Impl {
       if (!view.cached) {
         Occlude(view, all_rows);
         view.cache = view.current;
+        CacheOcclusion(view);
         view.cached = true;
         view.dirty.clear();
         all_rows_dirty = false;
@@ -1437,19 +1658,22 @@ struct KinectSensor::Impl {
     auto t1 = Clock::now();
     timings.cast += Seconds(t0, t1);
     // Rows whose occlusion can differ from the cache: those touched now or last frame (others
-    // keep the cached occlusion: their depth equals the cache).
-    std::vector<int> rows;
+    // keep the cached occlusion: their depth equals the cache), each within the columns touched.
     if (all_rows_dirty) {
-      rows = all_rows;
+      Occlude(view, all_rows);
     } else {
-      std::vector<char> row_dirty(k.height, 0);
-      for (const PixelSpan& s : view.dirty) row_dirty[s.row] = 1;
-      for (const PixelSpan& s : spans) row_dirty[s.row] = 1;
-      for (int v = 0; v < k.height; ++v) {
-        if (row_dirty[v]) rows.push_back(v);
+      std::vector<PixelSpan> changes(k.height, PixelSpan{0, k.width, -1});
+      for (const std::vector<PixelSpan>* list : {&view.dirty, &spans}) {
+        for (const PixelSpan& s : *list) {
+          PixelSpan& c = changes[s.row];
+          c.row = s.row;
+          c.first = std::min(c.first, s.first);
+          c.last = std::max(c.last, s.last);
+        }
       }
+      std::erase_if(changes, [](const PixelSpan& c) { return c.first > c.last; });
+      OccludeWindows(view, changes);
     }
-    Occlude(view, rows);
     timings.occlusion += Seconds(t1, Clock::now());
     uint64_t recast = mode == RenderMode::kFull ? static_cast<uint64_t>(pixels) : 0;
     for (const PixelSpan& s : spans) recast += s.last - s.first + 1;

@@ -309,6 +309,9 @@ TEST(KinectSensor, NoisyMissingPixelsConcentrateBesideEdgesOnTheProjectorSide) {
   (void)right_edge;
 }
 
+// Incremental frames re-scan the occlusion only in windows around what changed (see
+// OccludeWindows); full re-renders scan every row whole. Both kernels, both depth geometries (the
+// registered one has two occluder sources, the IR camera's own image one).
 TEST(KinectSensor, IncrementalFramesEqualFullRerenders) {
   RayScene scene;
   scene.AddStatic("wall", Quad(10, 10), FacingCamera(1.6, -Eigen::Vector3d::UnitZ()));
@@ -318,25 +321,66 @@ TEST(KinectSensor, IncrementalFramesEqualFullRerenders) {
   const uint32_t a = scene.AddMoving("a", Box(0.1, 0.05, 0.08));
   const uint32_t b = scene.AddMoving("b", Box(0.04, 0.04, 0.04));
   scene.Commit();
-  KinectSensorOptions options;
-  KinectSensor incremental(options, &scene, Rigid3::Identity());
-  KinectSensor full(options, &scene, Rigid3::Identity());
-  for (int i = 0; i < 12; ++i) {
-    const double s = 0.15 * i;
-    scene.SetPose(
-        a, Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(s, Eigen::Vector3d(1, 2, 3).normalized())),
-                  Eigen::Vector3d(-0.3 + 0.06 * i, 0.02 * std::sin(s), 0.9)));
-    scene.SetPose(
-        b, Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.2, -0.1 + 0.01 * i, 1.1)));
-    scene.SetVisible(b, i % 4 != 3);
-    scene.Commit();
-    const RgbdFrame x =
-        incremental.Render(i, i == 6 ? RenderMode::kFull : RenderMode::kIncremental);
-    const RgbdFrame y = full.Render(i, RenderMode::kFull);
-    ASSERT_EQ(x.depth, y.depth) << "frame " << i;
-    ASSERT_EQ(x.rgb, y.rgb) << "frame " << i;
+  for (const bool registered : {true, false}) {
+    for (const bool vector_kernels : {true, false}) {
+      SCOPED_TRACE(testing::Message() << "registered " << registered << ", vector kernels "
+                                      << KinectSensor::SetVectorKernels(vector_kernels));
+      KinectSensorOptions options;
+      options.registered = registered;
+      KinectSensor incremental(options, &scene, Rigid3::Identity());
+      KinectSensor full(options, &scene, Rigid3::Identity());
+      for (int i = 0; i < 12; ++i) {
+        // a goes right, then back left (the projector's shadow falls left of an object, beyond
+        // the columns it covered in the last frame); b goes down, then jumps left.
+        const double s = 0.15 * i;
+        const double a_x = i < 7 ? -0.3 + 0.06 * i : 0.06 - 0.07 * (i - 7);
+        scene.SetPose(
+            a,
+            Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(s, Eigen::Vector3d(1, 2, 3).normalized())),
+                   Eigen::Vector3d(a_x, 0.02 * std::sin(s), 0.9)));
+        scene.SetPose(b, Rigid3(Eigen::Quaterniond::Identity(),
+                                Eigen::Vector3d(i < 8 ? 0.2 : 0.1, -0.1 + 0.01 * i, 1.1)));
+        scene.SetVisible(b, i % 4 != 3);
+        scene.Commit();
+        const RgbdFrame x =
+            incremental.Render(i, i == 6 ? RenderMode::kFull : RenderMode::kIncremental);
+        const RgbdFrame y = full.Render(i, RenderMode::kFull);
+        ASSERT_EQ(x.depth, y.depth) << "frame " << i;
+        ASSERT_EQ(x.rgb, y.rgb) << "frame " << i;
+      }
+      EXPECT_LT(incremental.timings().pixels_recast, full.timings().pixels_recast / 3);
+    }
   }
-  EXPECT_LT(incremental.timings().pixels_recast, full.timings().pixels_recast / 3);
+  KinectSensor::SetVectorKernels(true);
+}
+
+// The projector's shadow of a moving object falls left of it, the IR camera's right of it: an
+// object moving left (right) casts a shadow where neither this frame's nor the last frame's
+// object was, which the incremental occlusion windows must reach. A wall alone behind it, so
+// that no static shadow hides the difference.
+TEST(KinectSensor, IncrementalShadowsOfObjectsMovingEitherWay) {
+  RayScene scene;
+  scene.AddStatic("wall", Quad(10, 10), FacingCamera(1.6, -Eigen::Vector3d::UnitZ()));
+  const uint32_t box = scene.AddMoving("box", Box(0.06, 0.3, 0.05));
+  scene.Commit();
+  for (const bool vector_kernels : {true, false}) {
+    SCOPED_TRACE(testing::Message()
+                 << "vector kernels " << KinectSensor::SetVectorKernels(vector_kernels));
+    KinectSensorOptions options;
+    KinectSensor incremental(options, &scene, Rigid3::Identity());
+    KinectSensor full(options, &scene, Rigid3::Identity());
+    for (int i = 0; i < 10; ++i) {
+      // Left by about 20 px a frame, then right again.
+      const double x = i < 5 ? 0.1 - 0.03 * i : -0.05 + 0.03 * (i - 5);
+      scene.SetPose(box, Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(x, 0, 0.8)));
+      scene.Commit();
+      const RgbdFrame a = incremental.Render(i, RenderMode::kIncremental);
+      const RgbdFrame b = full.Render(i, RenderMode::kFull);
+      ASSERT_EQ(a.depth, b.depth) << "frame " << i;
+      ASSERT_EQ(a.rgb, b.rgb) << "frame " << i;
+    }
+  }
+  KinectSensor::SetVectorKernels(true);
 }
 
 // The moving objects are cast only where their cluster boxes project (pixel centres inside the
