@@ -247,15 +247,15 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   return candidate;
 }
 
-std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
-    const RgbdFrame& frame, const std::optional<Rigid3>& predicted) {
+std::vector<IcpResult> ProxyTracker::CoarseHypotheses(const IcpOptions& coarse_icp,
+                                                      size_t* scored) const {
   const DetectionOptions& o = options_.detection;
   // The largest segment (component 0), evenly subsampled.
   std::vector<Eigen::Vector3f> segment;
   for (size_t i = 0; i < segmentation_.points.size(); ++i) {
     if (segmentation_.components[i] == 0) segment.push_back(segmentation_.points[i]);
   }
-  if (static_cast<int>(segment.size()) < options_.verification.min_points) return std::nullopt;
+  if (static_cast<int>(segment.size()) < options_.verification.min_points) return {};
   Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
   for (const auto& p : segment) centroid += p;
   centroid /= static_cast<float>(segment.size());
@@ -263,6 +263,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   const size_t stride = std::max<size_t>(1, segment.size() / o.coarse_points);
   for (size_t i = 0; i < segment.size(); i += stride) coarse.push_back(segment[i]);
   const size_t coarse_scored = coarse.size();
+  *scored = coarse_scored;
   // Skin-coloured points as many again at most: they count where they lie on the model (a
   // skin-coloured head or part tells a pose from its near-symmetric twins).
   const size_t skin_stride =
@@ -286,11 +287,6 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
   // The visible surface is about a third of the model's radius nearer than its centre.
   const Eigen::Vector3d ray = centroid.cast<double>().normalized();
   const Eigen::Vector3d center_guess = centroid.cast<double>() + 0.35 * model_->radius() * ray;
-  IcpOptions coarse_icp = search_icp_;
-  coarse_icp.max_iterations = o.coarse_iterations;
-  coarse_icp.start_distance = o.coarse_start_distance;
-  coarse_icp.end_distance = o.coarse_end_distance;
-  coarse_icp.shrink_iterations = std::max(1, o.coarse_iterations - 2);
   std::vector<IcpResult> coarse_results;
   for (const Eigen::Quaterniond& up : ups) {
     for (int k = 0; k < o.yaw_steps; ++k) {
@@ -303,6 +299,27 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(
           AlignPointToPlane(*model_, coarse, coarse_scored, options_.verification.skin_distance,
                             camera_T_proxy.Inverse(), coarse_icp, sample_matches_));
     }
+  }
+  return coarse_results;
+}
+
+std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& frame,
+                                                            const std::optional<Rigid3>& predicted,
+                                                            bool light) {
+  const DetectionOptions& o = options_.detection;
+  const Eigen::Quaterniond camera_R_table = camera_T_table_->rotation;
+  const double pi = std::numbers::pi;
+  IcpOptions coarse_icp = search_icp_;
+  coarse_icp.max_iterations = o.coarse_iterations;
+  coarse_icp.start_distance = o.coarse_start_distance;
+  coarse_icp.end_distance = o.coarse_end_distance;
+  coarse_icp.shrink_iterations = std::max(1, o.coarse_iterations - 2);
+  // The coarse hypotheses (not in a light check: only the motion model's seeds and the twins).
+  std::vector<IcpResult> coarse_results;
+  size_t coarse_scored = 1;
+  if (!light) {
+    coarse_results = CoarseHypotheses(coarse_icp, &coarse_scored);
+    if (coarse_results.empty()) return std::nullopt;
   }
   // Rank the coarse results as verified poses are ranked (track/proxy_tracker.h, Score).
   std::vector<double> scores(coarse_results.size());
@@ -649,21 +666,25 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     const Rigid3 corrected = icp.proxy_T_camera.Inverse();
     const DetectionOptions& d = options_.detection;
     ++frames_since_detection_;
-    if (chosen &&
-        (RotationAngle(corrected.rotation, predicted->rotation) >
-             d.recheck_rotation_deg * std::numbers::pi / 180 ||
-         (corrected.translation - predicted->translation).norm() > d.recheck_translation ||
-         candidate.free_space_violation > d.recheck_free_space ||
-         (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
+    const bool large_correction =
+        RotationAngle(corrected.rotation, predicted->rotation) >
+            d.recheck_rotation_deg * std::numbers::pi / 180 ||
+        (corrected.translation - predicted->translation).norm() > d.recheck_translation;
+    if (chosen && (large_correction || candidate.free_space_violation > d.recheck_free_space ||
+                   (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
       frames_since_detection_ = 0;
-      if (windowed) {
+      // A light check (periodic, or the free space growing) refines only the motion model's seeds
+      // and the twins, all around the predicted proxy, so the window's data suffices; a large
+      // correction searches the whole play area.
+      const bool light = d.light_rechecks && !large_correction;
+      if (windowed && !light) {
         // Compare on the same data: the whole play area.
         segment_whole_play_area();
         chosen = Verify(
             frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
                                      chosen->icp.proxy_T_camera, options_.icp, sample_matches_));
       }
-      std::optional<Candidate> detected = Detect(frame, predicted);
+      std::optional<Candidate> detected = Detect(frame, predicted, light);
       const bool far = detected && RotationAngle(detected->icp.proxy_T_camera.rotation,
                                                  chosen->icp.proxy_T_camera.rotation) > pi / 4;
       if (detected && detected->good &&
@@ -689,7 +710,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   if (!chosen) segment_whole_play_area();
   enough = result.points >= options_.verification.min_points;
   if (!chosen && enough) {
-    std::optional<Candidate> detected = Detect(frame, predicted);
+    std::optional<Candidate> detected = Detect(frame, predicted, false);
     frames_since_detection_ = 0;
     if (detected && detected->good) {
       chosen = detected;

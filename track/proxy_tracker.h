@@ -56,6 +56,11 @@ struct DetectionOptions {
   double recheck_translation = 0.03;
   int recheck_interval = 15;
   double recheck_free_space = 0.04;
+  // The periodic and free-space checks are light: they refine only the motion model's seeds (the
+  // prediction, the last pose, the displaced predictions) and the twins of the best, on the
+  // predicted proxy's window, without the coarse hypotheses over the whole play area (a loss and a
+  // large correction still search everything).
+  bool light_rechecks = true;
   double switch_margin = 0.05;
   // ... and far_switch_margin higher when it is more than 45 deg from the tracked pose (a verified
   // pose does not turn that far in a frame: such a switch is to a twin, or from one).
@@ -95,6 +100,7 @@ struct DetectionOptions {
     v("recheck_translation", recheck_translation);
     v("recheck_interval", recheck_interval);
     v("recheck_free_space", recheck_free_space);
+    v("light_rechecks", light_rechecks);
     v("switch_margin", switch_margin);
     v("far_switch_margin", far_switch_margin);
     v("trusted_frames", trusted_frames);
@@ -247,7 +253,12 @@ class ProxyTracker {
   // evidence suffices (returns true then).
   bool WeighRival(const RgbdFrame& frame, Candidate* chosen);
   // The global detection; `predicted` (the motion model's pose, when there is one) breaks ties.
-  std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted);
+  // `light`: only the motion model's seeds and the twins, no coarse hypotheses.
+  std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted,
+                                  bool light);
+  // The coarse hypotheses' alignments (orientations about the table normal, placed at the largest
+  // segment); *scored: how many of their points are scored. Empty without a large enough segment.
+  std::vector<IcpResult> CoarseHypotheses(const IcpOptions& coarse_icp, size_t* scored) const;
   Candidate Verify(const RgbdFrame& frame, const IcpResult& icp) const;
   // Of the model's camera-facing sparse samples with a depth reading: the share whose depth the
   // frame confirms (within free_space_margin) and the share it sees behind (free space).
