@@ -512,6 +512,24 @@ MMH_SIMD_CLONES void ColorRowPortable(const ColorParams& p, const uint8_t* in,
   }
 }
 
+// A windowed occlusion scan (OcclusionWindowPortable) starts at the block holding the change's
+// last (from the right) or first column, with the static scene's extremum of everything before
+// that block in scan order as its carry.
+template <bool kFromRight>
+inline float WindowStart(const float* cached, int n, int first, int last, int* block) {
+  const float infinity = std::numeric_limits<float>::infinity();
+  *block = (kFromRight ? last : first) / 16;
+  if constexpr (kFromRight) return (*block + 1) * 16 < n ? cached[(*block + 1) * 16] : infinity;
+  return *block > 0 ? cached[16 * *block - 1] : -infinity;
+}
+// It ends after block [i, i + 16) once the block lies past the change and the running extremum
+// equals the static scene's there.
+template <bool kFromRight>
+inline bool WindowEnds(const float* cached, int i, int first, int last, float carry) {
+  if constexpr (kFromRight) return i <= first && carry == cached[i];
+  return i + 15 >= last && carry == cached[i + 15];
+}
+
 // Hand-vectorised AVX-512 kernels (GCC 12 vectorises neither the bit manipulation nor floor
 // well). They mirror the portable kernels above operation by operation (the same IEEE
 // additions, multiplications, divisions, square roots, floors, comparisons and selections, in
@@ -884,13 +902,8 @@ MMH_AVX512 int OcclusionWindowAvx512(const float* us, const float* cached, int n
   const float infinity = std::numeric_limits<float>::infinity();
   const __m512 none = Set(kFromRight ? infinity : -infinity);
   const int direction = kFromRight ? 1 : -1;
-  int block = (kFromRight ? last : first) / 16;
-  float carry_value;
-  if constexpr (kFromRight) {
-    carry_value = (block + 1) * 16 < n ? cached[(block + 1) * 16] : infinity;
-  } else {
-    carry_value = block > 0 ? cached[16 * block - 1] : -infinity;
-  }
+  int block = 0;
+  float carry_value = WindowStart<kFromRight>(cached, n, first, last, &block);
   __m512 carry = Set(carry_value);
   for (; kFromRight ? block >= 0 : block < n / 16; block += kFromRight ? -1 : 1) {
     const int i = 16 * block;
@@ -904,11 +917,7 @@ MMH_AVX512 int OcclusionWindowAvx512(const float* us, const float* cached, int n
     carry_value = kFromRight ? std::min(carry_value, _mm512_reduce_min_ps(x))
                              : std::max(carry_value, _mm512_reduce_max_ps(x));
     carry = Set(carry_value);
-    if constexpr (kFromRight) {
-      if (i <= first && carry_value == cached[i]) return i;
-    } else {
-      if (i + 15 >= last && carry_value == cached[i + 15]) return i + 15;
-    }
+    if (WindowEnds<kFromRight>(cached, i, first, last, carry_value)) return kFromRight ? i : i + 15;
   }
   return kFromRight ? 0 : n - 1;
 }
@@ -930,14 +939,8 @@ MMH_AVX512 int OcclusionWindowAvx512(const float* us, const float* cached, int n
 template <bool kFromRight>
 int OcclusionWindowPortable(const float* us, const float* cached, int n, int first, int last,
                             uint8_t* flags) {
-  const float infinity = std::numeric_limits<float>::infinity();
-  int block = (kFromRight ? last : first) / 16;
-  float carry;
-  if constexpr (kFromRight) {
-    carry = (block + 1) * 16 < n ? cached[(block + 1) * 16] : infinity;
-  } else {
-    carry = block > 0 ? cached[16 * block - 1] : -infinity;
-  }
+  int block = 0;
+  float carry = WindowStart<kFromRight>(cached, n, first, last, &block);
   for (; kFromRight ? block >= 0 : block < n / 16; block += kFromRight ? -1 : 1) {
     const int i = 16 * block;
     if constexpr (kFromRight) {
@@ -945,14 +948,13 @@ int OcclusionWindowPortable(const float* us, const float* cached, int n, int fir
         flags[u] = static_cast<uint8_t>(us[u] >= carry);
         carry = std::min(carry, us[u]);
       }
-      if (i <= first && carry == cached[i]) return i;
     } else {
       for (int u = i; u < i + 16; ++u) {
         flags[u] = static_cast<uint8_t>(us[u] <= carry);
         carry = std::max(carry, us[u]);
       }
-      if (i + 15 >= last && carry == cached[i + 15]) return i + 15;
     }
+    if (WindowEnds<kFromRight>(cached, i, first, last, carry)) return kFromRight ? i : i + 15;
   }
   return kFromRight ? 0 : n - 1;
 }
@@ -988,6 +990,18 @@ bool UseAvx512Default() {
 std::atomic<bool>& UseAvx512() {
   static std::atomic<bool> use{UseAvx512Default()};
   return use;
+}
+
+// OcclusionWindowPortable or its vector kernel (same window, same flags).
+template <bool kFromRight>
+int OcclusionWindow(const float* us, const float* cached, int n, int first, int last,
+                    uint8_t* flags) {
+#if MMH_SENSOR_AVX512
+  if (UseAvx512().load(std::memory_order_relaxed)) {
+    return OcclusionWindowAvx512<kFromRight>(us, cached, n, first, last, flags);
+  }
+#endif
+  return OcclusionWindowPortable<kFromRight>(us, cached, n, first, last, flags);
 }
 
 // One depth row: its random numbers (drop_bits, normal: #n scratch), then the pixels, with the
@@ -1434,7 +1448,6 @@ struct KinectSensor::Impl {
     const int padded = (width + 15) / 16 * 16;
     Geometry& g = view.current;
     const double fx = view.intrinsics.fx;
-    const bool vector = UseAvx512().load(std::memory_order_relaxed) && MMH_SENSOR_AVX512;
     const size_t sources = view.occluder_sources.size();
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, changes.size(), 16),
@@ -1458,31 +1471,14 @@ struct KinectSensor::Impl {
               SourceRow(&g.disparity[row], width, fx, source_x, us.data());
               const float* cached = &view.source_extremum[k][cached_row];
               PixelSpan& w = windows[k];
-              if (source_x > 0) {
-                w.last = change.last / 16 * 16 + 15;
-#if MMH_SENSOR_AVX512
-                if (vector) {
-                  w.first = OcclusionWindowAvx512<true>(us.data(), cached, padded, change.first,
+              const bool from_right = source_x > 0;
+              const int far_end =
+                  (from_right ? OcclusionWindow<true>
+                              : OcclusionWindow<false>)(us.data(), cached, padded, change.first,
                                                         change.last, flags[k].data());
-                } else
-#endif
-                {
-                  w.first = OcclusionWindowPortable<true>(us.data(), cached, padded, change.first,
-                                                          change.last, flags[k].data());
-                }
-              } else {
-                w.first = change.first / 16 * 16;
-#if MMH_SENSOR_AVX512
-                if (vector) {
-                  w.last = OcclusionWindowAvx512<false>(us.data(), cached, padded, change.first,
-                                                        change.last, flags[k].data());
-                } else
-#endif
-                {
-                  w.last = OcclusionWindowPortable<false>(us.data(), cached, padded, change.first,
-                                                          change.last, flags[k].data());
-                }
-              }
+              // The near end: the start of the block holding the change's last (first) column.
+              w.first = from_right ? far_end : change.first / 16 * 16;
+              w.last = from_right ? change.last / 16 * 16 + 15 : far_end;
               lo = std::min(lo, w.first);
               hi = std::max(hi, w.last);
             }
