@@ -73,8 +73,7 @@ nlohmann::json AnimatorJson(const study::AnimatorOutcome& a) {
             {"total_cost", a.montage_summary.total_cost},
             {"unconstrained_cost", a.montage_summary.unconstrained_cost},
             {"constraint_increase_percent", a.montage_summary.constraint_increase_percent},
-            {"unconstrained_short_segments", a.montage_summary.unconstrained_short_segments},
-            {"cost_shift", a.cost_shift}}},
+            {"unconstrained_short_segments", a.montage_summary.unconstrained_short_segments}}},
           {"truth_montage_appeal", a.truth_montage_appeal.appeal},
           {"rendered_frames", a.rendered_frames},
           {"metrics", a.metrics}};
@@ -195,6 +194,16 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
   if (replicates > 1) {
     WriteFileAtomically(out / "replicates.csv", replicates_csv);
     WriteFileAtomically(out / "power.csv", power_csv);
+  }
+  if (s.measured_error_model) {
+    // The fit as pipeline/error_model.inc: copying it there makes it the fast mode's defaults.
+    const std::string origin =
+        "the full-fidelity study of " +
+        (args.common.config_file.empty() ? std::string("the defaults") : args.common.config_file) +
+        " (" + std::to_string(s.animators.size()) + " animators, population seed " +
+        std::to_string(study_config.run.render.population.seed) + ") at commit " + GitCommit() +
+        ".";
+    WriteFileAtomically(out / "error_model.inc", s.measured_error_model->DefaultsSource(origin));
   }
   WriteFileAtomically(out / "report.txt", report);
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");

@@ -129,10 +129,13 @@ void CollectAnnotation(const SessionJob& job, TakeRun& take) {
 
 // Stand-ins for the sessions in fast fidelity: the error model applied to the ground truth.
 void SimulateSessions(const RunConfig& config, std::uint64_t seed, TakeRun& take) {
+  // The tracker's failures depend on how the camera (placed by the config) sees the pose.
+  const sim::CameraPlacement& camera = config.render.camera;
   SimulatedTracking tracking = SimulateTracking(
       take.truth, config.error_model,
       sim::DeriveSeed(seed, {0x7472ull, static_cast<std::uint64_t>(take.performed.object),
-                             static_cast<std::uint64_t>(take.take)}));
+                             static_cast<std::uint64_t>(take.take)}),
+      Eigen::Vector3d(camera.x, camera.y, camera.z));
   SetTracked(std::move(tracking.tracked.poses), std::move(tracking.status), take);
   if (!take.truth_annotation.values.empty()) {
     const SimulatedReading reading = SimulateSliderReading(

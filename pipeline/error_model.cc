@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 #include "core/error.h"
 #include "core/options.h"
@@ -51,23 +52,31 @@ class Ar1 {
   bool started_ = false;
 };
 
-// Episodes that start at each free frame with probability `rate` and last a geometric number of
-// frames with mean `mean_frames`: the episode's number (0, 1, ...) for each of its frames, -1
-// elsewhere. Frames already in `busy` (>= 0) neither start nor extend an episode.
-std::vector<int> DrawEpisodes(int frames, double rate, double mean_frames,
+// Episodes of one kind on `frames` frames: an episode starts at a free frame t with probability
+// rate(c[t]) and ends after each of its frames u with probability 1 / mean_frames(c[u]) (the
+// hazards of `rates[c].*member`, see the header). The episode's number (0, 1, ...) for each of its
+// frames, -1 elsewhere. Frames already in `busy` (>= 0) neither start nor extend an episode.
+std::vector<int> DrawEpisodes(const std::vector<int>& condition, const ViewRates& view,
+                              double EpisodeRates::*rate, double EpisodeRates::*mean_frames,
                               const std::vector<int>& busy, std::uint64_t seed) {
+  const int frames = static_cast<int>(condition.size());
   std::vector<int> episode(frames, -1);
   sim::Random random(seed);
-  const double stop = 1.0 / mean_frames;
   int count = 0;
+  bool in_episode = false;
   for (int t = 0; t < frames; ++t) {
-    if (busy[t] >= 0 || !random.Bernoulli(rate)) continue;
-    // Length k >= 1 with P(k) = (1 - stop)^(k - 1) stop.
-    int k = 1;
-    while (!random.Bernoulli(stop)) ++k;
-    for (int u = t; u < std::min(frames, t + k) && busy[u] < 0; ++u) episode[u] = count;
-    ++count;
-    t += k - 1;
+    if (busy[t] >= 0) {
+      in_episode = false;
+      continue;
+    }
+    const EpisodeRates& rates = view.condition[condition[t]];
+    if (!in_episode) {
+      if (!random.Bernoulli(rates.*rate)) continue;
+      in_episode = true;
+      ++count;
+    }
+    episode[t] = count - 1;
+    if (random.Bernoulli(1.0 / (rates.*mean_frames))) in_episode = false;
   }
   return episode;
 }
@@ -95,44 +104,115 @@ std::array<double, 6> PoseError(const Rigid3& truth, const Rigid3& tracked) {
   return {r.x(), r.y(), r.z(), e.x(), e.y(), e.z()};
 }
 
-// Runs of true values: (number of runs, frames in them, frames at risk of starting one = frames
-// not in a run and not excluded).
+// Runs of true values per view condition: runs starting in it, frames free to start one (not in a
+// run and not excluded, plus the run starts), run frames in it and runs ending after one of them
+// (not counting a run cut by the end of the take).
 struct Runs {
-  int runs = 0;
-  std::int64_t frames = 0;
-  std::int64_t at_risk = 0;
+  std::array<std::int64_t, kViewConditions> starts{}, at_risk{}, frames{}, ends{};
+  std::int64_t Total(const std::array<std::int64_t, kViewConditions>& per) const {
+    std::int64_t sum = 0;
+    for (const std::int64_t n : per) sum += n;
+    return sum;
+  }
 };
-void CountRuns(const std::vector<bool>& flag, const std::vector<bool>& excluded, Runs* runs) {
-  for (std::size_t t = 0; t < flag.size(); ++t) {
+void CountRuns(const std::vector<bool>& flag, const std::vector<bool>& excluded,
+               const std::vector<int>& condition, Runs* runs) {
+  const std::size_t n = flag.size();
+  for (std::size_t t = 0; t < n; ++t) {
+    const int c = condition[t];
     if (flag[t]) {
-      ++runs->frames;
-      if (t == 0 || !flag[t - 1]) ++runs->runs;
+      ++runs->frames[c];
+      if (t == 0 || !flag[t - 1]) ++runs->starts[c], ++runs->at_risk[c];
+      if (t + 1 < n && !flag[t + 1]) ++runs->ends[c];
     } else if (!excluded[t]) {
-      ++runs->at_risk;
+      ++runs->at_risk[c];
     }
   }
 }
 
+// The hazards of one kind from its runs, per condition with data (the others keep the prior's).
+void FitHazards(const Runs& runs, double EpisodeRates::*rate, double EpisodeRates::*mean_frames,
+                ViewRates* view) {
+  for (int c = 0; c < kViewConditions; ++c) {
+    EpisodeRates& r = view->condition[c];
+    if (runs.at_risk[c] > 0) {
+      r.*rate = static_cast<double>(runs.starts[c]) / static_cast<double>(runs.at_risk[c]);
+    }
+    if (runs.ends[c] > 0) {
+      r.*mean_frames = static_cast<double>(runs.frames[c]) / static_cast<double>(runs.ends[c]);
+    }
+  }
+}
+
+std::string Number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", value);
+  return buffer;
+}
+
 }  // namespace
+
+const char* ViewConditionName(int condition) {
+  static constexpr const char* kNames[kViewConditions] = {
+      "heading_000", "heading_030", "heading_060", "heading_090", "heading_120",
+      "heading_150", "heading_180", "heading_210", "heading_240", "heading_270",
+      "heading_300", "heading_330", "lying"};
+  if (condition < 0 || condition >= kViewConditions) {
+    ThrowBadValue("view condition", std::to_string(condition),
+                  "0.." + std::to_string(kViewConditions - 1));
+  }
+  return kNames[condition];
+}
+
+ViewRates ViewRates::Uniform(const EpisodeRates& rates) {
+  ViewRates view;
+  view.condition.fill(rates);
+  return view;
+}
+
+void EpisodeRates::Validate(const std::string& prefix) const {
+  RequireProbability(loss_rate, prefix + ".loss_rate");
+  RequireEpisodeLength(loss_mean_frames, prefix + ".loss_mean_frames");
+  RequireProbability(flip_rate, prefix + ".flip_rate");
+  RequireEpisodeLength(flip_mean_frames, prefix + ".flip_mean_frames");
+  RequireProbability(spike_rate, prefix + ".spike_rate");
+  RequireEpisodeLength(spike_mean_frames, prefix + ".spike_mean_frames");
+}
+
+int ViewCondition(const Rigid3& table_T_proxy, const Eigen::Vector3d& table_camera_position,
+                  double lying_tilt_deg) {
+  const Eigen::Matrix3d rotation = table_T_proxy.rotation.toRotationMatrix();
+  const double tilt = std::acos(std::clamp(rotation(2, 2), -1.0, 1.0)) * 180.0 / kPi;
+  if (tilt > lying_tilt_deg) return kLying;
+  // The proxy's x axis and the direction to the camera, both in the table plane.
+  const Eigen::Vector3d facing = rotation.col(0);
+  const Eigen::Vector3d to_camera = table_camera_position - table_T_proxy.translation;
+  const double phi = std::atan2(facing.y(), facing.x()) - std::atan2(to_camera.y(), to_camera.x());
+  double degrees = std::fmod(phi * 180.0 / kPi, 360.0);
+  if (degrees < 0) degrees += 360.0;
+  return std::min(kHeadingSectors - 1, static_cast<int>(degrees / (360.0 / kHeadingSectors)));
+}
 
 void ErrorModelOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(translation_sd, prefix + ".translation_sd", "m");
   RequireNonNegative(rotation_sd, prefix + ".rotation_sd", "rad");
   RequireCorrelation(correlation, prefix + ".correlation");
-  RequireProbability(flip_rate, prefix + ".flip_rate");
-  RequireEpisodeLength(flip_mean_frames, prefix + ".flip_mean_frames");
   RequireFinite(flip_rotation, prefix + ".flip_rotation");
   if (flip_rotation < 0 || flip_rotation > kPi) {
     ThrowBadValue(prefix + ".flip_rotation", FormatNumber(flip_rotation),
                   "an angle in [0, pi] rad");
   }
   RequireNonNegative(flip_translation, prefix + ".flip_translation", "m");
-  RequireProbability(spike_rate, prefix + ".spike_rate");
-  RequireEpisodeLength(spike_mean_frames, prefix + ".spike_mean_frames");
   RequireNonNegative(spike_rotation_sd, prefix + ".spike_rotation_sd", "rad");
   RequireNonNegative(spike_translation_sd, prefix + ".spike_translation_sd", "m");
-  RequireProbability(loss_rate, prefix + ".loss_rate");
-  RequireEpisodeLength(loss_mean_frames, prefix + ".loss_mean_frames");
+  RequireFinite(lying_tilt_deg, prefix + ".lying_tilt_deg");
+  if (lying_tilt_deg <= 0 || lying_tilt_deg > 180) {
+    ThrowBadValue(prefix + ".lying_tilt_deg", FormatNumber(lying_tilt_deg),
+                  "an angle in (0, 180] degrees");
+  }
+  for (int c = 0; c < kViewConditions; ++c) {
+    view.condition[c].Validate(prefix + ".view." + ViewConditionName(c));
+  }
   RequireNonNegative(slider_sd, prefix + ".slider_sd", "slider units");
   RequireCorrelation(slider_correlation, prefix + ".slider_correlation");
   RequireFinite(slider_bias, prefix + ".slider_bias");
@@ -148,22 +228,30 @@ void ErrorModelOptions::Validate(const std::string& prefix) const {
 }
 
 SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOptions& options,
-                                   std::uint64_t seed) {
+                                   std::uint64_t seed,
+                                   const Eigen::Vector3d& table_camera_position) {
   options.Validate("error_model");
   const int frames = static_cast<int>(truth.size());
+  std::vector<int> condition(frames);
+  for (int t = 0; t < frames; ++t) {
+    condition[t] = ViewCondition(truth.poses[t], table_camera_position, options.lying_tilt_deg);
+  }
   SimulatedTracking out;
   out.tracked.timestamps = truth.timestamps;
   out.tracked.poses.resize(frames);
   out.status.assign(frames, track::TrackStatus::kTracked);
 
   const std::vector<int> none(frames, -1);
-  const std::vector<int> lost = DrawEpisodes(frames, options.loss_rate, options.loss_mean_frames,
-                                             none, sim::DeriveSeed(seed, {kLossStream}));
-  const std::vector<int> flip = DrawEpisodes(frames, options.flip_rate, options.flip_mean_frames,
-                                             lost, sim::DeriveSeed(seed, {kFlipStream}));
+  const ViewRates& view = options.view;
+  const std::vector<int> lost =
+      DrawEpisodes(condition, view, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, none,
+                   sim::DeriveSeed(seed, {kLossStream}));
+  const std::vector<int> flip =
+      DrawEpisodes(condition, view, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, lost,
+                   sim::DeriveSeed(seed, {kFlipStream}));
   const std::vector<int> spike =
-      DrawEpisodes(frames, options.spike_rate, options.spike_mean_frames, Union(lost, flip),
-                   sim::DeriveSeed(seed, {kSpikeStream}));
+      DrawEpisodes(condition, view, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames,
+                   Union(lost, flip), sim::DeriveSeed(seed, {kSpikeStream}));
 
   sim::Random random(sim::DeriveSeed(seed, {kPoseStream}));
   std::array<Ar1, 6> axes = {Ar1(options.rotation_sd, options.correlation),
@@ -266,7 +354,46 @@ nlohmann::json ErrorModelEstimate::ToJson() const {
           {"loss_episodes", loss_episodes},
           {"slider_frames", slider_frames},
           {"slider_missed", slider_missed},
-          {"slider_rmse", slider_rmse}};
+          {"slider_rmse", slider_rmse},
+          {"condition_frames", condition_frames}};
+}
+
+std::string ErrorModelEstimate::DefaultsSource(const std::string& origin) const {
+  const ErrorModelOptions& o = options;
+  std::string out =
+      "// The error model's measured defaults (pipeline/error_model.h), written by\n"
+      "// ErrorModelEstimate::DefaultsSource; regenerate with a full-fidelity study "
+      "(docs/study.md,\n"
+      "// \"Fidelity\"). Measured on: " +
+      origin + "\n// " + std::to_string(frames) + " tracked frames, " +
+      std::to_string(flip_episodes) + " flips, " + std::to_string(spike_episodes) + " spikes, " +
+      std::to_string(loss_episodes) + " losses.\n";
+  const auto constant = [&](const char* name, double value) {
+    out += std::string("inline constexpr double ") + name + " = " + Number(value) + ";\n";
+  };
+  constant("kTranslationSd", o.translation_sd);
+  constant("kRotationSd", o.rotation_sd);
+  constant("kCorrelation", o.correlation);
+  constant("kFlipRotation", o.flip_rotation);
+  constant("kFlipTranslation", o.flip_translation);
+  constant("kSpikeRotationSd", o.spike_rotation_sd);
+  constant("kSpikeTranslationSd", o.spike_translation_sd);
+  constant("kSliderSd", o.slider_sd);
+  constant("kSliderCorrelation", o.slider_correlation);
+  constant("kSliderBias", o.slider_bias);
+  constant("kSliderMissShare", o.slider_miss_share);
+  out +=
+      "// Per view condition: loss rate, mean frames; flip rate, mean frames; spike rate, mean "
+      "frames\n// (frames observed in it).\ninline constexpr ViewRates kView = {{{\n";
+  for (int c = 0; c < kViewConditions; ++c) {
+    const EpisodeRates& r = o.view.condition[c];
+    out += "    {" + Number(r.loss_rate) + ", " + Number(r.loss_mean_frames) + ", " +
+           Number(r.flip_rate) + ", " + Number(r.flip_mean_frames) + ", " + Number(r.spike_rate) +
+           ", " + Number(r.spike_mean_frames) + "},  // " + ViewConditionName(c) + " (" +
+           std::to_string(condition_frames[c]) + ")\n";
+  }
+  out += "}}};\n";
+  return out;
 }
 
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
@@ -296,7 +423,11 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
     }
     std::vector<std::array<double, 6>> errors(n);
     std::vector<bool> lost(n), flip(n), spike(n), inlier(n), lost_or_flip(n);
+    std::vector<int> condition(n);
     for (std::size_t t = 0; t < n; ++t) {
+      condition[t] =
+          ViewCondition(obs.truth->poses[t], obs.table_camera_position, prior.lying_tilt_deg);
+      ++estimate.condition_frames[condition[t]];
       lost[t] = (*obs.status)[t] == track::TrackStatus::kLost;
       if (lost[t]) continue;
       errors[t] = PoseError(obs.truth->poses[t], obs.tracked->poses[t]);
@@ -326,17 +457,17 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
       }
     }
     estimate.frames += static_cast<std::int64_t>(n);
-    CountRuns(lost, std::vector<bool>(n, false), &loss_runs);
+    CountRuns(lost, std::vector<bool>(n, false), condition, &loss_runs);
     for (std::size_t t = 0; t < n; ++t) lost_or_flip[t] = lost[t] || flip[t];
-    CountRuns(flip, lost, &flip_runs);
-    CountRuns(spike, lost_or_flip, &spike_runs);
+    CountRuns(flip, lost, condition, &flip_runs);
+    CountRuns(spike, lost_or_flip, condition, &spike_runs);
   }
-  estimate.lost_frames = loss_runs.frames;
-  estimate.flip_frames = flip_runs.frames;
-  estimate.spike_frames = spike_runs.frames;
-  estimate.loss_episodes = loss_runs.runs;
-  estimate.flip_episodes = flip_runs.runs;
-  estimate.spike_episodes = spike_runs.runs;
+  estimate.lost_frames = loss_runs.Total(loss_runs.frames);
+  estimate.flip_frames = flip_runs.Total(flip_runs.frames);
+  estimate.spike_frames = spike_runs.Total(spike_runs.frames);
+  estimate.loss_episodes = static_cast<int>(loss_runs.Total(loss_runs.starts));
+  estimate.flip_episodes = static_cast<int>(flip_runs.Total(flip_runs.starts));
+  estimate.spike_episodes = static_cast<int>(spike_runs.Total(spike_runs.starts));
   ErrorModelOptions& fit = estimate.options;
   if (estimate.inlier_frames > 0) {
     const double axes = 3.0 * static_cast<double>(estimate.inlier_frames);
@@ -352,26 +483,16 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
     denominator += lag_squares[type] / (sd * sd);
   }
   if (denominator > 0) fit.correlation = std::clamp(numerator / denominator, 0.0, 0.999);
-  if (loss_runs.at_risk > 0) {
-    fit.loss_rate = static_cast<double>(loss_runs.runs) / static_cast<double>(loss_runs.at_risk);
-  }
-  if (loss_runs.runs > 0) {
-    fit.loss_mean_frames = static_cast<double>(loss_runs.frames) / loss_runs.runs;
-  }
-  const auto rate = [](const Runs& runs) {
-    return static_cast<double>(runs.runs) / static_cast<double>(runs.at_risk);
-  };
-  if (flip_runs.at_risk > 0) fit.flip_rate = rate(flip_runs);
-  if (spike_runs.at_risk > 0) fit.spike_rate = rate(spike_runs);
-  if (flip_runs.runs > 0) {
-    const double frames = static_cast<double>(flip_runs.frames);
-    fit.flip_mean_frames = frames / flip_runs.runs;
+  FitHazards(loss_runs, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, &fit.view);
+  FitHazards(flip_runs, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, &fit.view);
+  FitHazards(spike_runs, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames, &fit.view);
+  if (estimate.flip_frames > 0) {
+    const double frames = static_cast<double>(estimate.flip_frames);
     fit.flip_rotation = flip_angle_sum / frames;
     fit.flip_translation = flip_distance_sum / frames;
   }
-  if (spike_runs.runs > 0) {
-    const double frames = static_cast<double>(spike_runs.frames);
-    fit.spike_mean_frames = frames / spike_runs.runs;
+  if (estimate.spike_frames > 0) {
+    const double frames = static_cast<double>(estimate.spike_frames);
     fit.spike_rotation_sd = std::sqrt(spike_squares[0] / (3 * frames));
     fit.spike_translation_sd = std::sqrt(spike_squares[1] / (3 * frames));
   }

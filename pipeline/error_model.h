@@ -8,16 +8,22 @@
 // (Exp(r_t), e_t) with r_t (rotation vector [rad]) and e_t (translation [m]) in the proxy frame,
 // each of the six components an independent stationary AR(1) process
 //   x_{t+1} = ρ x_t + sqrt(1 − ρ²) σ n_t,  n_t ~ N(0, 1),  x_0 ~ N(0, σ²),
-// so that Var x_t = σ² and Corr(x_t, x_{t+1}) = ρ. On top of that, three kinds of episode, each
-// starting at a free frame with its rate and lasting a geometric number of frames with its mean
-// (P(k) = (1 − 1/L)^(k−1) / L, k ≥ 1), drawn in this order on the frames the earlier kinds left:
+// so that Var x_t = σ² and Corr(x_t, x_{t+1}) = ρ. On top of that, three kinds of episode, drawn
+// in this order on the frames the earlier kinds left:
 //   losses  the frames are reported lost (the last reported pose held);
 //   flips   the tracker holds the proxy's near-symmetric twin: the pose turned by flip_rotation
 //           about the table's vertical and moved by flip_translation in a horizontal direction
-//           (both fixed per episode; the Soldier lying on its back, tracked upside down);
+//           (both fixed per episode; the Soldier seen side-on, tracked the wrong way round);
 //   spikes  a short wrong fit: an error rotation vector and translation drawn per episode
 //           (N(0, spike_rotation_sd²) and N(0, spike_translation_sd²) per axis, proxy frame),
 //           added to the AR(1) error.
+// The tracker fails where the view is ambiguous, so each kind's episodes depend on how the
+// performed pose is seen: the frame's view condition c(t) (ViewCondition: the sector of the
+// proxy's heading relative to the camera, or "lying" when it is tilted over) sets the hazards. An
+// episode starts at a free frame t with probability rate(c(t)) and, after each of its frames u,
+// ends with probability 1 / mean_frames(c(u)) (a two-state Markov chain per kind; with one
+// condition the lengths are geometric with mean mean_frames, P(k) = (1 − 1/L)^(k−1) / L); it also
+// ends at a frame an earlier kind took.
 //
 // Slider reading: read_t = clamp(truth_t + bias + s_t, −5, 5), s_t an AR(1) process like the
 // above (sd slider_sd, lag-one correlation slider_correlation); a frame is not found with
@@ -25,6 +31,8 @@
 // before any is found).
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -36,50 +44,93 @@
 
 namespace mmh::pipeline {
 
+// The episode hazards of one view condition (see the top of the file): episodes per free frame and
+// mean length [frames] of losses, flips and spikes.
+struct EpisodeRates {
+  double loss_rate = 0.0;
+  double loss_mean_frames = 1.0;
+  double flip_rate = 0.0;
+  double flip_mean_frames = 1.0;
+  double spike_rate = 0.0;
+  double spike_mean_frames = 1.0;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("loss_rate", loss_rate);
+    v("loss_mean_frames", loss_mean_frames);
+    v("flip_rate", flip_rate);
+    v("flip_mean_frames", flip_mean_frames);
+    v("spike_rate", spike_rate);
+    v("spike_mean_frames", spike_mean_frames);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+// View conditions: kHeadingSectors sectors of the proxy's heading relative to the camera (sector k:
+// φ in [k·30°, (k+1)·30°), φ the angle in the table plane from the direction proxy → camera to the
+// proxy's x axis, counter-clockwise seen from above; 0: facing the camera, 180°: facing away), and
+// kLying (the proxy's z axis more than lying_tilt_deg from the table's vertical, where the heading
+// says little).
+inline constexpr int kHeadingSectors = 12;
+inline constexpr int kLying = kHeadingSectors;
+inline constexpr int kViewConditions = kHeadingSectors + 1;
+// "heading_000", "heading_030", ..., "heading_330", "lying".
+const char* ViewConditionName(int condition);
+
+// The hazards per view condition (section "error_model.view").
+struct ViewRates {
+  std::array<EpisodeRates, kViewConditions> condition;
+
+  template <class V>
+  void VisitFields(V& v) {
+    for (int c = 0; c < kViewConditions; ++c) v(ViewConditionName(c), condition[c]);
+  }
+  // The same hazards in every condition.
+  static ViewRates Uniform(const EpisodeRates& rates);
+};
+
+// The measured defaults: pipeline/error_model.inc, written by a full-fidelity study
+// (`mmh study ... --out DIR` writes DIR/error_model.inc; docs/study.md, "Fidelity", says how).
+namespace measured {
+#include "pipeline/error_model.inc"
+}  // namespace measured
+
 struct ErrorModelOptions {
   // Every default is measured (EstimateErrorModel) on the full-fidelity study of
-  // configs/study_soldier.json: 20 animators, 60 Soldier takes, 124 487 tracked and read frames,
-  // with the tracker of commit ea8e4c8 (docs/study.md, "Fidelity").
+  // configs/study_soldier.json (pipeline/error_model.inc says on what: takes, frames, commit).
   // Pose errors (see above), per axis in the proxy frame, over the frames within the tracker's
   // success criterion.
-  double translation_sd = 0.00110;  // σ_e [m]
-  double rotation_sd = 0.0160;      // σ_r [rad]
-  double correlation = 0.678;       // ρ, lag one, in [0, 1)
-  // Flips (see above): episodes per frame, mean length [frames], rotation [rad], translation [m].
-  double flip_rate = 0.00158;
-  double flip_mean_frames = 23.5;
-  double flip_rotation = 3.14;
-  double flip_translation = 0.0061;
-  // Spikes (see above): episodes per frame, mean length [frames], per-axis sizes [rad], [m].
-  double spike_rate = 0.00479;
-  double spike_mean_frames = 2.35;
-  double spike_rotation_sd = 0.0974;
-  double spike_translation_sd = 0.0056;
-  // Losses: episodes per frame, mean length [frames]; their frames are reported lost.
-  double loss_rate = 0.00101;
-  double loss_mean_frames = 1.70;
+  double translation_sd = measured::kTranslationSd;  // σ_e [m]
+  double rotation_sd = measured::kRotationSd;        // σ_r [rad]
+  double correlation = measured::kCorrelation;       // ρ, lag one, in [0, 1)
+  // Flips (see above): rotation [rad] and translation [m] of the twin.
+  double flip_rotation = measured::kFlipRotation;
+  double flip_translation = measured::kFlipTranslation;
+  // Spikes (see above): per-axis sizes [rad], [m].
+  double spike_rotation_sd = measured::kSpikeRotationSd;
+  double spike_translation_sd = measured::kSpikeTranslationSd;
+  // Where the proxy counts as lying (view condition kLying) [deg of its z axis from vertical].
+  double lying_tilt_deg = 45.0;
+  // Episode hazards per view condition.
+  ViewRates view = measured::kView;
   // Slider reading: AR(1) noise [slider units] with its lag-one correlation, a bias, and the share
   // of frames in which the block is not found.
-  double slider_sd = 0.164;
-  double slider_correlation = 0.0;
-  double slider_bias = 0.0675;
-  double slider_miss_share = 0.0;
+  double slider_sd = measured::kSliderSd;
+  double slider_correlation = measured::kSliderCorrelation;
+  double slider_bias = measured::kSliderBias;
+  double slider_miss_share = measured::kSliderMissShare;
 
   template <class V>
   void VisitFields(V& v) {
     v("translation_sd", translation_sd);
     v("rotation_sd", rotation_sd);
     v("correlation", correlation);
-    v("flip_rate", flip_rate);
-    v("flip_mean_frames", flip_mean_frames);
     v("flip_rotation", flip_rotation);
     v("flip_translation", flip_translation);
-    v("spike_rate", spike_rate);
-    v("spike_mean_frames", spike_mean_frames);
     v("spike_rotation_sd", spike_rotation_sd);
     v("spike_translation_sd", spike_translation_sd);
-    v("loss_rate", loss_rate);
-    v("loss_mean_frames", loss_mean_frames);
+    v("lying_tilt_deg", lying_tilt_deg);
+    v("view", view);
     v("slider_sd", slider_sd);
     v("slider_correlation", slider_correlation);
     v("slider_bias", slider_bias);
@@ -88,14 +139,21 @@ struct ErrorModelOptions {
   void Validate(const std::string& prefix) const;
 };
 
+// The view condition of a performed pose (table_T_proxy) seen from a camera at
+// `table_camera_position` (the camera's centre in the table frame).
+int ViewCondition(const Rigid3& table_T_proxy, const Eigen::Vector3d& table_camera_position,
+                  double lying_tilt_deg);
+
 struct SimulatedTracking {
   Trajectory tracked;  // table_T_proxy, #frames (lost frames: the last reported pose held)
   std::vector<track::TrackStatus> status;  // #frames
 };
 
-// What the tracker reports for `truth` (table_T_proxy). Deterministic in `seed`.
+// What the tracker reports for `truth` (table_T_proxy) seen from a camera at
+// `table_camera_position` (table frame). Deterministic in `seed`.
 SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOptions& options,
-                                   std::uint64_t seed);
+                                   std::uint64_t seed,
+                                   const Eigen::Vector3d& table_camera_position);
 
 struct SimulatedReading {
   Annotation read;          // #frames, in [-5, 5], the last value held where not found
@@ -113,6 +171,7 @@ struct TrackingObservation {
   const Trajectory* truth = nullptr;    // table_T_proxy
   const Trajectory* tracked = nullptr;  // table_T_proxy as reported
   const std::vector<track::TrackStatus>* status = nullptr;
+  Eigen::Vector3d table_camera_position = Eigen::Vector3d::Zero();  // the camera's centre
 };
 
 // One slider reading against the block's true values (all #frames).
@@ -125,6 +184,7 @@ struct ReadingObservation {
 struct ErrorModelEstimate {
   ErrorModelOptions options;  // the fitted model (fields without data keep `prior`'s values)
   std::int64_t frames = 0;    // tracked frames observed
+  std::array<std::int64_t, kViewConditions> condition_frames{};  // of them, per view condition
   std::int64_t inlier_frames = 0;
   std::int64_t flip_frames = 0;
   std::int64_t spike_frames = 0;
@@ -137,6 +197,9 @@ struct ErrorModelEstimate {
   double slider_rmse = 0.0;
 
   nlohmann::json ToJson() const;
+  // pipeline/error_model.inc with these options as the measured defaults; `origin` is a comment
+  // saying where they were measured (e.g. the study's config and commit).
+  std::string DefaultsSource(const std::string& origin) const;
 };
 
 // Fits the model by moments. Frames within gross_threshold_deg and gross_threshold_m (the
@@ -146,8 +209,12 @@ struct ErrorModelEstimate {
 // of consecutive such frames: rate = episodes / frames at risk (the frames not in an episode of
 // that kind or an earlier one), mean = frames / episodes; flip_rotation and flip_translation are
 // the mean error angle and distance over flip frames, the spike sizes the per-axis RMS over spike
-// frames. The slider's bias, sd and lag-one correlation over found frames, miss share = missed /
-// frames. The maximum-likelihood estimates of the model for a large sample.
+// frames. Per view condition (ViewCondition of the true pose, with prior.lying_tilt_deg): the start
+// rate = episodes starting in it / its frames free at the time (not in an episode of that kind or
+// an earlier one), the mean length = its episode frames / the episodes ending after one of them
+// (the Markov chain's maximum-likelihood hazards); a condition without frames keeps `prior`'s. The
+// slider's bias, sd and lag-one correlation over found frames, miss share = missed / frames. The
+// maximum-likelihood estimates of the model for a large sample.
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
                                       const std::vector<ReadingObservation>& readings,
                                       const ErrorModelOptions& prior = {},

@@ -46,18 +46,6 @@ AnimatorOutcome Summarise(const StudyConfig& config, int index, pipeline::Animat
       sim::Appraise(run.truth_montage.trajectory, run.truth_montage_quality, config.viewer);
   for (const auto& segment : run.montage.segments) out.montage_takes.push_back(segment.take);
   out.montage_summary = run.montage.summary;
-  // The data cost C_d = -a'(t) makes C_T negative where takes are liked; segment_costs.csv wants
-  // costs >= 0, so both costs are reported above the constant sum_t max(5, max_l a'_l(t)) (the
-  // same for every labelling of the n reference frames, so the optimum is unchanged).
-  const auto& warped = run.montage.warped_annotations;
-  double shift = 0.0;
-  const std::size_t n = warped.empty() ? 0 : warped.front().size();
-  for (std::size_t t = 0; t < n; ++t) {
-    double best = kMaxAnnotation;
-    for (const auto& take : warped) best = std::max(best, take[t]);
-    shift += best;
-  }
-  out.cost_shift = shift;
   out.metrics = std::move(run.metrics);
   out.rendered_frames = run.rendered_frames;
   out.seconds = run.seconds;
@@ -131,8 +119,10 @@ StudyData ScoreStudy(const StudyConfig& config, const std::vector<AnimatorOutcom
   data.rankings = RankOwnAnimations(appeals, config.viewer, config.study.seed);
   for (const AnimatorOutcome& a : animators) {
     const auto& s = a.montage_summary;
-    data.segment_costs.push_back({a.id, s.unconstrained_cost + a.cost_shift,
-                                  std::max(s.total_cost, s.unconstrained_cost) + a.cost_shift,
+    // The compositor's costs as they are (negative where takes are liked: C_d = -a'(t)); the
+    // constrained optimum cannot be below the unconstrained one (rounding aside).
+    data.segment_costs.push_back({a.id, s.unconstrained_cost,
+                                  std::max(s.total_cost, s.unconstrained_cost),
                                   s.unconstrained_short_segments, 0});
   }
   return data;
@@ -177,7 +167,8 @@ SimulatedStudy RunSimulatedStudy(const StudyConfig& config, int replicate,
     std::vector<pipeline::ReadingObservation> readings;
     for (const auto& a : study.animators) {
       for (const auto& take : a.takes) {
-        tracking.push_back({&take.truth, &take.tracked, &take.status});
+        tracking.push_back(
+            {&take.truth, &take.tracked, &take.status, take.camera_T_table.Inverse().translation});
         readings.push_back({&take.truth_annotation, &take.read_annotation, &take.slider_found});
       }
     }

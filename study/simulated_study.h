@@ -83,9 +83,6 @@ struct AnimatorOutcome {
   sim::Appeal truth_montage_appeal;      // the montage of the ground truth, for comparison
   std::vector<int> montage_takes;        // take of each montage segment
   montage::ComposeSummary montage_summary;
-  // Added to both montage costs in segment_costs.csv (see ScoreStudy): sum over the reference
-  // frames of max(5, max_l a'_l(t)), so that the costs are >= 0 as the schema requires.
-  double cost_shift = 0.0;
   nlohmann::json metrics;  // the run's metrics.json
   int rendered_frames = 0;
   pipeline::StageSeconds seconds;

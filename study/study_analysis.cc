@@ -366,10 +366,10 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
       SegmentConstraintAnalysis::Animator an;
       an.animator = row.animator;
       an.short_segments_unconstrained = row.short_segments_unconstrained;
-      an.increase_percent =
-          row.cost_unconstrained == 0.0
-              ? 0.0
-              : 100.0 * (row.cost_constrained - row.cost_unconstrained) / row.cost_unconstrained;
+      an.increase_percent = row.cost_unconstrained == 0.0
+                                ? 0.0
+                                : 100.0 * (row.cost_constrained - row.cost_unconstrained) /
+                                      std::abs(row.cost_unconstrained);
       if (an.short_segments_unconstrained > 0) {
         ++s.animators_with_short_segments;
         s.max_increase_percent = std::max(s.max_increase_percent, an.increase_percent);

@@ -209,10 +209,10 @@ StudyData ReadStudyData(const std::filesystem::path& dir, const StudyDataOptions
       SegmentCostRow s;
       s.line = row.line;
       s.animator = ParseId(row.fields[0], table.Where(row.line, "animator"));
-      s.cost_unconstrained = ParseFinite(row.fields[1], table.Where(row.line, "cost_unconstrained"),
-                                         "a finite cost >= 0");
-      s.cost_constrained = ParseFinite(row.fields[2], table.Where(row.line, "cost_constrained"),
-                                       "a finite cost >= 0");
+      s.cost_unconstrained =
+          ParseFinite(row.fields[1], table.Where(row.line, "cost_unconstrained"), "a finite cost");
+      s.cost_constrained =
+          ParseFinite(row.fields[2], table.Where(row.line, "cost_constrained"), "a finite cost");
       s.short_segments_unconstrained = ParseInt(
           row.fields[3], table.Where(row.line, "short_segments_unconstrained"), 0, "a count >= 0");
       data.segment_costs.push_back(s);
@@ -330,8 +330,9 @@ void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
   for (const auto& s : data.segment_costs) {
     const std::string where = WhereRow(data.segment_costs_source, s.line);
     CheckId(s.animator, where + ", column 'animator'");
-    RequireNonNegative(s.cost_unconstrained, where + ", column 'cost_unconstrained'");
-    RequireNonNegative(s.cost_constrained, where + ", column 'cost_constrained'");
+    // Costs may be negative (the compositor's data cost is -a'(t)); they must be finite.
+    RequireFinite(s.cost_unconstrained, where + ", column 'cost_unconstrained'");
+    RequireFinite(s.cost_constrained, where + ", column 'cost_constrained'");
     if (s.short_segments_unconstrained < 0) {
       ThrowBadValue(where + ", column 'short_segments_unconstrained'",
                     std::to_string(s.short_segments_unconstrained), "a count >= 0");

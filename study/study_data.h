@@ -76,8 +76,9 @@ StudyData ReadStudyData(const std::filesystem::path& dir, const StudyDataOptions
 
 // The consistency rules of docs/statistics.md: unique (animator, item) and (scorer, animator,
 // take); every animator ranks the same items, with ranks a permutation of 1..#items (or valid
-// mid-ranks); take numbers 1..K all present among the comparisons; costs finite, >= 0, constrained
-// >= unconstrained; at most one cost row per animator. Throws InputError naming source and line.
+// mid-ranks); take numbers 1..K all present among the comparisons; costs finite (negative allowed:
+// the compositor's data cost is -a'), constrained >= unconstrained; at most one cost row per
+// animator. Throws InputError naming source and line.
 void ValidateStudyData(const StudyData& data, const StudyDataOptions& options = {});
 
 // The CSV text of each file (header and one line per row, numbers in shortest round-trip form).

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "core/error.h"
 
@@ -13,6 +15,8 @@ namespace mmh::pipeline {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// The camera of configs/soldier.json (table frame).
+const Eigen::Vector3d kCamera(0.0, -0.9, 0.75);
 
 // A slow circular walk with turning, #frames at 30 fps.
 Trajectory Walk(int frames) {
@@ -51,12 +55,10 @@ TEST(ErrorModelTest, PoseErrorsHaveTheModelsSdAndCorrelation) {
   options.translation_sd = 0.002;
   options.rotation_sd = 0.01;
   options.correlation = 0.8;
-  options.loss_rate = 0;
-  options.flip_rate = 0;
-  options.spike_rate = 0;
+  options.view = ViewRates::Uniform({});  // no episodes
   const int frames = 40000;
   const Trajectory truth = Walk(frames);
-  const SimulatedTracking sim = SimulateTracking(truth, options, 7);
+  const SimulatedTracking sim = SimulateTracking(truth, options, 7, kCamera);
   ASSERT_EQ(sim.tracked.size(), truth.size());
   double sq_r = 0, sq_t = 0, lag = 0, lag_sq = 0;
   std::array<double, 6> previous{};
@@ -83,7 +85,7 @@ TEST(ErrorModelTest, PoseErrorsHaveTheModelsSdAndCorrelation) {
 }
 
 // Runs of frames where `flag` holds: (runs, frames in them, frames at risk = not flagged and not
-// excluded).
+// excluded, and the runs' first frames).
 struct RunCount {
   int runs = 0, frames = 0, at_risk = 0;
 };
@@ -92,7 +94,7 @@ RunCount CountRuns(const std::vector<bool>& flag, const std::vector<bool>& exclu
   for (std::size_t t = 0; t < flag.size(); ++t) {
     if (flag[t]) {
       ++c.frames;
-      if (t == 0 || !flag[t - 1]) ++c.runs;
+      if (t == 0 || !flag[t - 1]) ++c.runs, ++c.at_risk;  // the start frame was free
     } else if (!excluded[t]) {
       ++c.at_risk;
     }
@@ -115,18 +117,19 @@ TEST(ErrorModelTest, EpisodesHaveTheModelsRatesLengthsAndSizes) {
   ErrorModelOptions options;
   options.rotation_sd = 0.0075;
   options.translation_sd = 0.0005;
-  options.loss_rate = 0.01;
-  options.loss_mean_frames = 4;
-  options.flip_rate = 0.002;
-  options.flip_mean_frames = 20;
+  const EpisodeRates rates{.loss_rate = 0.01,
+                           .loss_mean_frames = 4,
+                           .flip_rate = 0.002,
+                           .flip_mean_frames = 20,
+                           .spike_rate = 0.01,
+                           .spike_mean_frames = 2};
+  options.view = ViewRates::Uniform(rates);
   options.flip_translation = 0.05;
-  options.spike_rate = 0.01;
-  options.spike_mean_frames = 2;
   options.spike_rotation_sd = 0.3;
   options.spike_translation_sd = 0.01;
   const int frames = 200000;
   const Trajectory truth = Walk(frames);
-  const SimulatedTracking sim = SimulateTracking(truth, options, 11);
+  const SimulatedTracking sim = SimulateTracking(truth, options, 11, kCamera);
   std::vector<bool> lost(frames), flip(frames), spike(frames), lost_or_flip(frames);
   double flip_angle = 0, flip_distance = 0;
   std::vector<std::array<double, 6>> spike_errors;  // one per spike episode (its first frame)
@@ -152,11 +155,11 @@ TEST(ErrorModelTest, EpisodesHaveTheModelsRatesLengthsAndSizes) {
     }
     if (spike[t] && (t == 0 || !spike[t - 1])) spike_errors.push_back(e);
   }
-  ExpectEpisodes(CountRuns(lost, std::vector<bool>(frames, false)), options.loss_rate,
-                 options.loss_mean_frames, 0.0, "losses");
+  ExpectEpisodes(CountRuns(lost, std::vector<bool>(frames, false)), rates.loss_rate,
+                 rates.loss_mean_frames, 0.0, "losses");
   const RunCount flips = CountRuns(flip, lost);
-  ExpectEpisodes(flips, options.flip_rate, options.flip_mean_frames, 1.0, "flips");
-  ExpectEpisodes(CountRuns(spike, lost_or_flip), options.spike_rate, options.spike_mean_frames, 0.1,
+  ExpectEpisodes(flips, rates.flip_rate, rates.flip_mean_frames, 1.0, "flips");
+  ExpectEpisodes(CountRuns(spike, lost_or_flip), rates.spike_rate, rates.spike_mean_frames, 0.1,
                  "spikes");
   // A flip turns the pose by pi (less the core noise) and moves it by flip_translation
   // horizontally (the core noise adds in quadrature).
@@ -183,13 +186,14 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   options.translation_sd = 0.0007;
   options.rotation_sd = 0.009;
   options.correlation = 0.7;
-  options.loss_rate = 0.004;
-  options.loss_mean_frames = 3;
-  options.flip_rate = 0.0005;
-  options.flip_mean_frames = 50;
+  const EpisodeRates rates{.loss_rate = 0.004,
+                           .loss_mean_frames = 3,
+                           .flip_rate = 0.0005,
+                           .flip_mean_frames = 50,
+                           .spike_rate = 0.005,
+                           .spike_mean_frames = 1.5};
+  options.view = ViewRates::Uniform(rates);
   options.flip_translation = 0.06;
-  options.spike_rate = 0.005;
-  options.spike_mean_frames = 1.5;
   options.spike_rotation_sd = 0.4;
   options.spike_translation_sd = 0.02;
   options.slider_sd = 0.15;
@@ -202,7 +206,7 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   std::vector<SimulatedReading> reads;
   for (int take = 0; take < 10; ++take) {
     truths.push_back(Walk(8000));
-    sims.push_back(SimulateTracking(truths.back(), options, 100 + take));
+    sims.push_back(SimulateTracking(truths.back(), options, 100 + take, kCamera));
     Annotation a;
     for (int t = 0; t < 8000; ++t) {
       a.timestamps.push_back(t / 30.0);
@@ -214,7 +218,7 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   std::vector<TrackingObservation> tracking;
   std::vector<ReadingObservation> readings;
   for (int take = 0; take < 10; ++take) {
-    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status});
+    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status, kCamera});
     readings.push_back({&slider_truths[take], &reads[take].read, &reads[take].found});
   }
   const ErrorModelEstimate estimate = EstimateErrorModel(tracking, readings, ErrorModelOptions{});
@@ -224,18 +228,28 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   EXPECT_NEAR(fit.translation_sd, options.translation_sd, sd_tolerance * options.translation_sd);
   EXPECT_NEAR(fit.rotation_sd, options.rotation_sd, sd_tolerance * options.rotation_sd);
   EXPECT_NEAR(fit.correlation, options.correlation, 4 * std::sqrt((1 - 0.49) / (2 * n)) + 0.005);
-  EXPECT_NEAR(fit.loss_rate, options.loss_rate,
-              4 * options.loss_rate / std::sqrt(estimate.loss_episodes));
-  EXPECT_NEAR(fit.loss_mean_frames, options.loss_mean_frames, 0.3);
-  EXPECT_NEAR(fit.flip_rate, options.flip_rate,
-              4 * options.flip_rate / std::sqrt(estimate.flip_episodes));
-  EXPECT_NEAR(fit.flip_mean_frames, options.flip_mean_frames,
-              4 * options.flip_mean_frames / std::sqrt(estimate.flip_episodes) + 1);
+  // The hazards are fitted per view condition; with the same hazards in every condition their
+  // frame-weighted means recover them (the walk sweeps every heading sector).
+  const auto pooled = [&](double EpisodeRates::*member) {
+    double sum = 0, weight = 0;
+    for (int c = 0; c < kViewConditions; ++c) {
+      sum += fit.view.condition[c].*member * estimate.condition_frames[c];
+      weight += estimate.condition_frames[c];
+    }
+    return sum / weight;
+  };
+  EXPECT_NEAR(pooled(&EpisodeRates::loss_rate), rates.loss_rate,
+              4 * rates.loss_rate / std::sqrt(estimate.loss_episodes));
+  EXPECT_NEAR(pooled(&EpisodeRates::loss_mean_frames), rates.loss_mean_frames, 0.3);
+  EXPECT_NEAR(pooled(&EpisodeRates::flip_rate), rates.flip_rate,
+              4 * rates.flip_rate / std::sqrt(estimate.flip_episodes));
+  EXPECT_NEAR(pooled(&EpisodeRates::flip_mean_frames), rates.flip_mean_frames,
+              4 * rates.flip_mean_frames / std::sqrt(estimate.flip_episodes) + 1);
   EXPECT_NEAR(fit.flip_rotation, options.flip_rotation, 0.03);
   EXPECT_NEAR(fit.flip_translation, options.flip_translation, 0.003);
   // Spikes within the success criterion (5 deg, 1 cm) count as inliers: with these sizes few are.
-  EXPECT_NEAR(fit.spike_rate, options.spike_rate,
-              4 * options.spike_rate / std::sqrt(estimate.spike_episodes) + 0.0005);
+  EXPECT_NEAR(pooled(&EpisodeRates::spike_rate), rates.spike_rate,
+              4 * rates.spike_rate / std::sqrt(estimate.spike_episodes) + 0.0005);
   EXPECT_NEAR(fit.spike_rotation_sd, options.spike_rotation_sd, 0.1 * options.spike_rotation_sd);
   const double slider_n = double(estimate.slider_frames - estimate.slider_missed);
   const double slider_rel = SdRelativeError(slider_n, options.slider_correlation);
@@ -246,6 +260,139 @@ TEST(ErrorModelTest, EstimatorRecoversTheOptions) {
   EXPECT_NEAR(fit.slider_correlation, options.slider_correlation, 0.02);
   const double p = options.slider_miss_share;
   EXPECT_NEAR(fit.slider_miss_share, p, 4 * std::sqrt(p * (1 - p) / estimate.slider_frames));
+}
+
+TEST(ErrorModelTest, ViewConditionIsTheHeadingSectorSeenFromTheCamera) {
+  // A proxy at the origin, the camera on the −y side: facing the camera is heading −90° in the
+  // table frame.
+  const auto facing = [](double heading_deg, double tilt_deg = 0) {
+    return Rigid3(
+        Eigen::Quaterniond(Eigen::AngleAxisd(heading_deg * kPi / 180, Eigen::Vector3d::UnitZ()) *
+                           Eigen::AngleAxisd(tilt_deg * kPi / 180, Eigen::Vector3d::UnitX())),
+        Eigen::Vector3d::Zero());
+  };
+  EXPECT_EQ(ViewCondition(facing(-90), kCamera, 45), 0);     // facing the camera
+  EXPECT_EQ(ViewCondition(facing(-75), kCamera, 45), 0);     // 15° counter-clockwise
+  EXPECT_EQ(ViewCondition(facing(-105), kCamera, 45), 11);   // 15° clockwise
+  EXPECT_EQ(ViewCondition(facing(0), kCamera, 45), 3);       // 90°: side-on
+  EXPECT_EQ(ViewCondition(facing(90), kCamera, 45), 6);      // facing away
+  EXPECT_EQ(ViewCondition(facing(170), kCamera, 45), 8);     // 260°
+  EXPECT_EQ(ViewCondition(facing(90, 30), kCamera, 45), 6);  // leaning, still upright
+  EXPECT_EQ(ViewCondition(facing(90, 60), kCamera, 45), kLying);
+  EXPECT_EQ(ViewCondition(facing(0, 120), kCamera, 45), kLying);
+  // The direction to the camera is taken from the proxy's position: a proxy at (0.9, −0.9)
+  // facing −x faces the camera at (0, −0.9).
+  Rigid3 beside = facing(180);
+  beside.translation = Eigen::Vector3d(0.9, -0.9, 0);
+  EXPECT_EQ(ViewCondition(beside, kCamera, 45), 0);
+  EXPECT_STREQ(ViewConditionName(0), "heading_000");
+  EXPECT_STREQ(ViewConditionName(6), "heading_180");
+  EXPECT_STREQ(ViewConditionName(kLying), "lying");
+  EXPECT_THROW(ViewConditionName(kViewConditions), InputError);
+}
+
+// A walk that turns through every heading and lies down for 5 s in every 20 s.
+Trajectory WalkAndLie(int frames) {
+  Trajectory walk = Walk(frames);
+  for (int t = 0; t < frames; ++t) {
+    if (t % 600 >= 450) {
+      walk.poses[t].rotation = walk.poses[t].rotation * Eigen::Quaterniond(Eigen::AngleAxisd(
+                                                            kPi / 2, Eigen::Vector3d::UnitY()));
+    }
+  }
+  return walk;
+}
+
+TEST(ErrorModelTest, EpisodesFollowTheViewConditionAndTheEstimatorRecoversThem) {
+  // Flips only facing away (heading_180) and lying, longer spikes while lying, losses everywhere.
+  ErrorModelOptions options;
+  options.view = ViewRates::Uniform({.loss_rate = 0.002,
+                                     .loss_mean_frames = 2,
+                                     .flip_rate = 0,
+                                     .flip_mean_frames = 1,
+                                     .spike_rate = 0.004,
+                                     .spike_mean_frames = 2});
+  options.view.condition[6].flip_rate = 0.02;
+  options.view.condition[6].flip_mean_frames = 10;
+  options.view.condition[kLying].flip_rate = 0.01;
+  options.view.condition[kLying].flip_mean_frames = 30;
+  options.view.condition[kLying].spike_rate = 0.03;
+  options.spike_rotation_sd = 0.4;
+  options.spike_translation_sd = 0.02;
+  const int frames = 30000;
+  std::vector<Trajectory> truths;
+  std::vector<SimulatedTracking> sims;
+  std::vector<TrackingObservation> tracking;
+  for (int take = 0; take < 4; ++take) truths.push_back(WalkAndLie(frames));
+  for (int take = 0; take < 4; ++take) {
+    sims.push_back(SimulateTracking(truths[take], options, 300 + take, kCamera));
+  }
+  for (int take = 0; take < 4; ++take) {
+    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status, kCamera});
+    // No flip starts where the flip rate is 0 (an episode may run on into the next condition).
+    for (int t = 0; t < frames; ++t) {
+      const auto e = Error(truths[take].poses[t], sims[take].tracked.poses[t]);
+      const bool flip = std::hypot(e[0], e[1], e[2]) > kPi / 2;
+      const auto prev = t > 0 ? Error(truths[take].poses[t - 1], sims[take].tracked.poses[t - 1])
+                              : std::array<double, 6>{};
+      const bool flip_before = t > 0 && std::hypot(prev[0], prev[1], prev[2]) > kPi / 2;
+      if (flip && !flip_before && sims[take].status[t] != track::TrackStatus::kLost) {
+        const int c = ViewCondition(truths[take].poses[t], kCamera, options.lying_tilt_deg);
+        EXPECT_TRUE(c == 6 || c == kLying) << "flip starting in " << ViewConditionName(c);
+      }
+    }
+  }
+  const ErrorModelEstimate estimate = EstimateErrorModel(tracking, {}, options);
+  std::int64_t total = 0;
+  for (const auto n : estimate.condition_frames) total += n;
+  EXPECT_EQ(total, 4 * frames);
+  ASSERT_GT(estimate.condition_frames[kLying], 20000);
+  // Each condition's hazards within 4 standard errors (Poisson counts over its frames).
+  for (int c = 0; c < kViewConditions; ++c) {
+    const EpisodeRates& truth = options.view.condition[c];
+    const EpisodeRates& fit = estimate.options.view.condition[c];
+    const double n = double(estimate.condition_frames[c]);
+    ASSERT_GT(n, 3000) << ViewConditionName(c);
+    EXPECT_NEAR(fit.flip_rate, truth.flip_rate, 4 * std::sqrt(truth.flip_rate / (0.7 * n)))
+        << ViewConditionName(c);
+    EXPECT_NEAR(fit.spike_rate, truth.spike_rate, 4 * std::sqrt(truth.spike_rate / (0.7 * n)))
+        << ViewConditionName(c);
+    EXPECT_NEAR(fit.loss_rate, truth.loss_rate, 4 * std::sqrt(truth.loss_rate / (0.7 * n)))
+        << ViewConditionName(c);
+  }
+  // Lengths where there are many episodes: geometric, sd ≈ mean.
+  const auto& lying = estimate.options.view.condition[kLying];
+  EXPECT_NEAR(lying.flip_mean_frames, 30, 4 * 30 / std::sqrt(0.01 * 0.5 * 20000));
+  EXPECT_NEAR(lying.spike_mean_frames, 2, 0.4);
+}
+
+TEST(ErrorModelTest, TheCommittedDefaultsAreTheGeneratorsOutput) {
+  // pipeline/error_model.inc is what DefaultsSource writes for the defaults it defines (after its
+  // header comment, which says where they were measured): regenerating it from a study's fit is a
+  // copy, and every default is read back exactly.
+  ErrorModelEstimate estimate;
+  const std::string generated = estimate.DefaultsSource("test");
+  std::ifstream file(std::string(MMH_SOURCE_DIR) + "/pipeline/error_model.inc");
+  ASSERT_TRUE(file.good());
+  const std::string committed((std::istreambuf_iterator<char>(file)),
+                              std::istreambuf_iterator<char>());
+  const auto body = [](const std::string& text) {
+    const auto start = text.find("inline constexpr");
+    std::string out = text.substr(start);
+    // The per-condition frame counts are comments.
+    std::string stripped;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) {
+      const auto comment = line.find("  // ");
+      stripped += (comment == std::string::npos ? line : line.substr(0, comment)) + "\n";
+    }
+    return stripped;
+  };
+  EXPECT_EQ(body(generated), body(committed));
+  // Another estimate writes other numbers, and a study's fit compiles as the defaults.
+  estimate.options.view.condition[6].flip_rate = 0.125;
+  EXPECT_NE(body(estimate.DefaultsSource("test")), body(committed));
+  EXPECT_NE(estimate.DefaultsSource("study X").find("0.125, "), std::string::npos);
 }
 
 TEST(ErrorModelTest, SliderReadingStaysInRangeAndHoldsMissedFrames) {
@@ -276,11 +423,11 @@ TEST(ErrorModelTest, SliderReadingStaysInRangeAndHoldsMissedFrames) {
 
 TEST(ErrorModelTest, DeterministicPerSeed) {
   ErrorModelOptions options;
-  options.loss_rate = 0.01;
+  options.view.condition[0].loss_rate = 0.01;
   const Trajectory truth = Walk(2000);
-  const auto a = SimulateTracking(truth, options, 5);
-  const auto b = SimulateTracking(truth, options, 5);
-  const auto c = SimulateTracking(truth, options, 6);
+  const auto a = SimulateTracking(truth, options, 5, kCamera);
+  const auto b = SimulateTracking(truth, options, 5, kCamera);
+  const auto c = SimulateTracking(truth, options, 6, kCamera);
   bool differs = false;
   for (std::size_t t = 0; t < truth.size(); ++t) {
     EXPECT_EQ(a.tracked.poses[t].translation, b.tracked.poses[t].translation);
@@ -310,11 +457,24 @@ TEST(ErrorModelTest, BadOptionsNameTheField) {
     EXPECT_NE(std::string(e.what()).find("error_model.correlation"), std::string::npos) << e.what();
   }
   options = {};
-  options.loss_mean_frames = 0.5;
+  options.view.condition[kLying].loss_mean_frames = 0.5;
+  try {
+    options.Validate("error_model");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("error_model.view.lying.loss_mean_frames"),
+              std::string::npos)
+        << e.what();
+  }
+  options = {};
+  options.view.condition[6].flip_rate = 1.5;
+  EXPECT_THROW(options.Validate("error_model"), InputError);
+  options = {};
+  options.lying_tilt_deg = 0;
   EXPECT_THROW(options.Validate("error_model"), InputError);
   options = {};
   options.translation_sd = std::nan("");
-  EXPECT_THROW(SimulateTracking(Walk(10), options, 1), InputError);
+  EXPECT_THROW(SimulateTracking(Walk(10), options, 1, kCamera), InputError);
   options = {};
   options.slider_miss_share = 1.0;
   EXPECT_THROW(options.Validate("error_model"), InputError);

@@ -163,6 +163,24 @@ TEST(StudyData, SegmentCostRules) {
   ExpectContains(ErrorReading(f), {"segment_costs.csv:2", "'nan'"});
 }
 
+TEST(StudyData, NegativeCostsAreAccepted) {
+  // The compositor's data cost is -a'(t): C_T is negative where the takes are liked.
+  Files f;
+  f.segment_costs =
+      "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained\n"
+      "A,-200,-199,2\nB,-50.5,3,0\n";
+  TempDir dir;
+  f.Write(dir);
+  const StudyData data = ReadStudyData(dir.path());
+  ASSERT_EQ(data.segment_costs.size(), 2u);
+  EXPECT_EQ(data.segment_costs[0].cost_unconstrained, -200.0);
+  EXPECT_EQ(data.segment_costs[1].cost_constrained, 3.0);
+  // Still: the constraint cannot lower the optimum.
+  f.segment_costs =
+      "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained\nA,-10,-11,2\n";
+  ExpectContains(ErrorReading(f), {"segment_costs.csv:2", "column 'cost_constrained'", "-11"});
+}
+
 TEST(StudyData, MissingFilesAndFolders) {
   TempDir dir;
   ExpectContains(ErrorOf([&] { ReadStudyData(dir / "nope"); }), {"nope", "not a folder"});
