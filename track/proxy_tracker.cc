@@ -71,6 +71,7 @@ void VerificationOptions::Validate(const std::string& prefix) const {
   }
   RequireNonNegative(max_penetration, prefix + ".max_penetration", "m");
   RequireNonNegative(skin_distance, prefix + ".skin_distance", "m");
+  RequireNonNegative(max_skin_evidence, prefix + ".max_skin_evidence");
   if (max_points < min_points) {
     ThrowBadValue(prefix + ".max_points", std::to_string(max_points), ">= min_points");
   }
@@ -97,11 +98,13 @@ struct ProxyTracker::Candidate {
   // camera sees through. Near-symmetric proxies (the Soldier's body is
   // symmetric under a half turn; only its rifle is not) are told apart by both. (The share of the
   // model the data confirms is no guide: the hand in front of the model confirms a wrong pose.)
+  // The skin-coloured points count up to max_skin_evidence (VerificationOptions).
+  double max_skin_evidence = 1.0;
   double Score() const {
-    const double explained =
-        icp.inlier_share > 0 ? icp.inlier_share * (icp.inliers + icp.extra_inliers) / icp.inliers
-                             : 0.0;
-    return explained - 2 * free_space_violation;
+    if (icp.inliers <= 0) return -2 * free_space_violation;
+    const double scored = icp.inliers / icp.inlier_share;
+    return icp.inlier_share + std::min(icp.extra_inliers / scored, max_skin_evidence) -
+           2 * free_space_violation;
   }
 };
 
@@ -217,6 +220,7 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   const VerificationOptions& o = options_.verification;
   Candidate candidate;
   candidate.icp = icp;
+  candidate.max_skin_evidence = o.max_skin_evidence;
   const Rigid3 camera_T_proxy = icp.proxy_T_camera.Inverse();
   const Visibility visibility = ModelVisibility(frame, camera_T_proxy);
   candidate.free_space_violation = visibility.violation;

@@ -139,6 +139,12 @@ struct VerificationOptions {
   // surfaces that can look skin-coloured (the Soldier's head and rifle), the other points only
   // surfaces that can look otherwise (track/point_to_plane_icp.h, sample_matches).
   bool colour_matching = true;
+  // Candidate poses are ranked by the share of the segmented points they explain plus the
+  // skin-coloured points on skin-coloured model surfaces (per segmented point), but the latter
+  // count up to this share only: the hand holding the proxy supplies any number of skin points
+  // near it, and a twin that turns a skin-coloured face (Mario's) into the hand would otherwise
+  // outscore the true pose; a skin-coloured head or rifle (the Soldier's) is a smaller share.
+  double max_skin_evidence = 0.3;
   // At most this many segmented points enter the ICP (evenly subsampled) [points].
   int max_points = 1500;
 
@@ -154,6 +160,7 @@ struct VerificationOptions {
     v("max_predicted_frames", max_predicted_frames);
     v("skin_distance", skin_distance);
     v("colour_matching", colour_matching);
+    v("max_skin_evidence", max_skin_evidence);
     v("max_points", max_points);
   }
   void Validate(const std::string& prefix) const;

@@ -76,10 +76,8 @@ TEST(ProxyTrackerTest, DemoWalkWithHand) {
   EXPECT_GE(result.summary.success_rate, 0.99);
 }
 
-// Five more walks (other noise seeds, 6-10 s rounds, yaw swings 0.2-0.6 rad), pooled: every loss
-// recovered within 15 frames, but one of them (seed 3) spends 7 frames in the Soldier's
-// upside-down twin, so not every take reaches 99 % (docs/tracker.md, "Known weaknesses"); the
-// pooled share is guarded at 98 %.
+// Five more walks (other noise seeds, 6-10 s rounds, yaw swings 0.2-0.6 rad), pooled: the issue's
+// thresholds (measured 99.6 % pooled, longest failure 2 frames: the first detection).
 TEST(ProxyTrackerTest, OtherWalksPooled) {
   int frames = 0, successes = 0, longest = 0;
   std::vector<double> rotations, translations;
@@ -99,7 +97,7 @@ TEST(ProxyTrackerTest, OtherWalksPooled) {
   }
   EXPECT_LE(metrics::Quantile(rotations, 0.5), 1.0);
   EXPECT_LE(metrics::Quantile(translations, 0.5), 0.002);
-  EXPECT_GE(static_cast<double>(successes) / frames, 0.98);
+  EXPECT_GE(static_cast<double>(successes) / frames, 0.99);
   EXPECT_LE(longest, 15);
 }
 
@@ -180,16 +178,20 @@ TEST(ProxyTrackerTest, SoldierStoryTakesByFourAnimators) {
 }
 
 // Survey (not part of the suite): MMH_SURVEY="animator:take:first:frames ..." tracks those
-// stretches of Soldier story recordings and prints every failed frame, with the score of the true
-// pose refined on the same data (is the failure the tracker's search or the data's minimum?).
+// stretches of Soldier story recordings (or of another story: MMH_SURVEY_CONFIG=configs/mario.json;
+// MMH_SURVEY_SET="tracker.x=v ..." overrides options) and prints every failed frame, with the score
+// of the true pose refined on the same data (is the failure the tracker's search or the data's
+// minimum?).
 TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
   const char* spec = std::getenv("MMH_SURVEY");
   std::istringstream in(spec ? spec : "3:1:0:300");
   for (std::string item; in >> item;) {
     int animator = 0, take_index = 0, first = 0, frames = 0, take_frames = 0;
     std::sscanf(item.c_str(), "%d:%d:%d:%d", &animator, &take_index, &first, &frames);
+    const char* story_config = std::getenv("MMH_SURVEY_CONFIG");
     test_take::SimTake take = test_take::SoldierStorySession(
-        MMH_SOURCE_DIR, animator, take_index, sim::RenderSession::kRecording, &take_frames);
+        MMH_SOURCE_DIR, animator, take_index, sim::RenderSession::kRecording, &take_frames,
+        story_config ? story_config : "configs/study_soldier.json");
     frames = std::min(frames, take_frames - first);
     std::printf("== animator %d take %d frames %d..%d of %d\n", animator, take_index, first,
                 first + frames, take_frames);

@@ -89,11 +89,13 @@ class SimTake {
 // take with the hand on it, an annotation session rests the proxy beside the play area and moves
 // the slider block as the participant annotates the take. *frames: the take's length.
 // `source` is the project's folder (MMH_SOURCE_DIR).
+// `config_file` (relative to `source`) may name another story's config (configs/mario.json).
 inline SimTake SoldierStorySession(const std::string& source, int animator, int take,
-                                   sim::RenderSession session, int* frames) {
+                                   sim::RenderSession session, int* frames,
+                                   const std::string& config_file = "configs/study_soldier.json") {
   sim::RenderConfig config =
-      sim::RenderConfig::FromConfig(Config::Load(source + "/configs/study_soldier.json"));
-  config.render.story = source + "/configs/stories/soldier.json";
+      sim::RenderConfig::FromConfig(Config::Load(source + "/" + config_file));
+  config.render.story = source + "/" + config.render.story;
   config.render.animator = animator;
   config.render.take = take;
   config.render.session = session;
