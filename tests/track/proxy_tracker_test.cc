@@ -121,8 +121,8 @@ TEST(ProxyTrackerTest, FastTumblingWithHand) {
   EXPECT_LE(result.summary.median_rotation_deg, 1.0);
   EXPECT_LE(result.summary.median_translation, 0.002);
   // Tilted under the hand, the boxy Soldier shows little more than one face for a few frames:
-  // single frames reach 5-7 deg (documented in docs/tracker.md), never for long.
-  EXPECT_GE(result.summary.success_rate, 0.97);
+  // single frames reach 5-7 deg (documented in docs/tracker.md), never for long (measured 99.5 %).
+  EXPECT_GE(result.summary.success_rate, 0.99);
   EXPECT_LE(result.summary.longest_failure, 3);
 }
 
@@ -145,8 +145,9 @@ TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
   const TakeResult result = TrackTake(take, 200);  // jumps at frames 60, 120, 180
   EXPECT_TRUE(result.summary.all_recovered);
   EXPECT_LE(result.summary.longest_failure, 15);
-  // The frames of each jump fail until recovered (at most 15 each by the line above).
-  EXPECT_GE(result.summary.success_rate, 0.85);
+  // The frames of each jump fail until recovered (at most 15 each by the line above; measured
+  // 95.5 %).
+  EXPECT_GE(result.summary.success_rate, 0.92);
   int detections = 0;
   for (const auto& frame : result.frames) detections += frame.detected;
   EXPECT_GE(detections, 4);  // the first frame and each jump
@@ -175,6 +176,23 @@ TEST(ProxyTrackerTest, SoldierStoryTakesByFourAnimators) {
     EXPECT_TRUE(result.summary.all_recovered);
     EXPECT_LE(result.summary.longest_failure, 15);
   }
+}
+
+// The Mario story (configs/mario.json), participant 0's take 0, frames 150-449: Mario's half turn
+// about the vertical (16 mm off) explains the hand's skin-coloured points with his face better
+// than the true pose does; with the skin evidence uncapped (verification.max_skin_evidence) the
+// tracker took that twin from frame 196 on (77 % of the take). The thresholds (measured
+// 100 %, 0.8 deg, 0.7 mm over the whole take).
+TEST(ProxyTrackerTest, MarioStoryTakeKeepsTheTruthOverItsTwin) {
+  int take_frames = 0;
+  test_take::SimTake take = test_take::SoldierStorySession(
+      MMH_SOURCE_DIR, 0, 0, sim::RenderSession::kRecording, &take_frames, "configs/mario.json");
+  ASSERT_GE(take_frames, 450);
+  const TakeResult result = TrackTake(take, 300, {}, 150);
+  EXPECT_LE(result.summary.median_rotation_deg, 1.0);
+  EXPECT_LE(result.summary.median_translation, 0.002);
+  EXPECT_GE(result.summary.success_rate, 0.99);
+  EXPECT_LE(result.summary.longest_failure, 15);
 }
 
 // Survey (not part of the suite): MMH_SURVEY="animator:take:first:frames ..." tracks those
