@@ -1,6 +1,7 @@
 #include "track/table_plane.h"
 
 #include <pcl/ModelCoefficients.h>
+#include <pcl/console/print.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl/sample_consensus/method_types.h>
@@ -9,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 #include <vector>
 
@@ -57,6 +59,11 @@ std::optional<TablePlane> EstimateTablePlane(const RgbdFrame& frame,
     return std::nullopt;
   }
 
+  // RANSAC draws degenerate (collinear) samples now and then and simply draws again; PCL reports
+  // each one on stderr at its error level, which would fill the terminal of `mmh run --quiet`.
+  // Our own failures are reported through `why`.
+  static std::once_flag quiet_pcl;
+  std::call_once(quiet_pcl, [] { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); });
   std::vector<TablePlane> planes;
   pcl::SACSegmentation<pcl::PointXYZ> ransac;
   ransac.setOptimizeCoefficients(true);
