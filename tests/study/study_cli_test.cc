@@ -24,6 +24,34 @@ std::string SmallStudy(const std::string& extra = "") {
          extra;
 }
 
+// A full-fidelity study renders and tracks every session and fits the error model to what the
+// tracker did: DIR/error_model.inc, the file that regenerates fast fidelity's defaults
+// (pipeline/error_model.inc, docs/study.md "Fidelity"). Three animators with 61-frame takes (the
+// shortest a montage allows) keep it to a few seconds.
+TEST(StudyCliTest, FullFidelityWritesTheErrorModelFit) {
+  TempDir dir;
+  const auto out = dir / "study";
+  const auto run = RunMmh("study --config " + kSource + "/configs/study_soldier.json --set " +
+                          "render.story=" + kSource + "/configs/stories/soldier.json --set " +
+                          "run.practice=" + kSource + "/configs/stories/mario.json --set " +
+                          "study.animators=3 --set render.frames=61 --quiet --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string fit = ReadBytes(out / "error_model.inc");
+  EXPECT_NE(
+      fit.find("full-fidelity study of " + kSource + "/configs/study_soldier.json (3 animators"),
+      std::string::npos)
+      << fit;
+  // 3 animators x 3 takes x 61 frames.
+  EXPECT_NE(fit.find("// 549 tracked frames"), std::string::npos) << fit;
+  const std::string key = "inline constexpr double kTranslationSd = ";
+  const auto at = fit.find(key);
+  ASSERT_NE(at, std::string::npos) << fit;
+  const double translation_sd = std::stod(fit.substr(at + key.size()));
+  EXPECT_GT(translation_sd, 1e-4);  // the tracker's jitter, about a millimetre
+  EXPECT_LT(translation_sd, 1e-2);
+  EXPECT_NE(fit.find("inline constexpr ViewRates kView"), std::string::npos);
+}
+
 TEST(StudyCliTest, WritesEverythingAndStatsReproducesIt) {
   TempDir dir;
   const auto out = dir / "study";
@@ -54,6 +82,8 @@ TEST(StudyCliTest, WritesEverythingAndStatsReproducesIt) {
     EXPECT_TRUE(std::filesystem::exists(out / file)) << file;
   }
   EXPECT_FALSE(std::filesystem::exists(out / "power.csv"));
+  // Only a full-fidelity study measures the tracker (FullFidelityWritesTheErrorModelFit).
+  EXPECT_FALSE(std::filesystem::exists(out / "error_model.inc"));
   const auto results = nlohmann::json::parse(ReadBytes(out / "results.json"));
   EXPECT_EQ(results["design"]["comparisons"], 4 * 3 * 7);
   EXPECT_EQ(results["design"]["scorers"], 28);
