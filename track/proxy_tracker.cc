@@ -379,6 +379,21 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   std::optional<Candidate> best;
   // The verified poses (proxy_T_camera) and their scores, for the rival below.
   std::vector<std::pair<Rigid3, double>> verified;
+  // Verifies a refined pose and ranks it against the best so far.
+  auto weigh = [&](const IcpResult& refined) {
+    Candidate candidate = Verify(frame, refined);
+    if (better(candidate, best)) best = candidate;
+    if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
+  };
+  // The same for a pose not refined to before (each distinct pose counts once).
+  auto weigh_distinct = [&](const IcpResult& refined) {
+    if (std::any_of(refined_poses.begin(), refined_poses.end(),
+                    [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
+      return;
+    }
+    refined_poses.push_back(refined.proxy_T_camera);
+    weigh(refined);
+  };
   // The motion model's poses are candidates too (the prediction and the last measured pose),
   // refined as the twins are: the coarse hypotheses sample yaw every 30 deg, and when a
   // near-symmetric twin scores as well as the truth (its distinguishing part under the hand), only
@@ -409,30 +424,14 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   }
   for (const Rigid3& seed : seeds) {
     const IcpResult coarse_seed = refine(seed.Inverse(), coarse_icp);
-    const IcpResult refined = refine(coarse_seed.proxy_T_camera, search_icp_);
-    if (std::any_of(refined_poses.begin(), refined_poses.end(),
-                    [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
-      continue;
-    }
-    refined_poses.push_back(refined.proxy_T_camera);
-    Candidate candidate = Verify(frame, refined);
-    if (better(candidate, best)) best = candidate;
-    if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
+    weigh_distinct(refine(coarse_seed.proxy_T_camera, search_icp_));
   }
   const size_t seeded = refined_poses.size();
   for (size_t c = 0;
        c < order.size() && static_cast<int>(refined_poses.size() - seeded) < o.candidates &&
        c < static_cast<size_t>(3 * o.candidates);
        ++c) {
-    const IcpResult refined = refine(coarse_results[order[c]].proxy_T_camera, search_icp_);
-    if (std::any_of(refined_poses.begin(), refined_poses.end(),
-                    [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
-      continue;
-    }
-    refined_poses.push_back(refined.proxy_T_camera);
-    Candidate candidate = Verify(frame, refined);
-    if (better(candidate, best)) best = candidate;
-    if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
+    weigh_distinct(refine(coarse_results[order[c]].proxy_T_camera, search_icp_));
   }
   // Near-symmetric twins of the best pose: turned by quarter turns about the model's own axes
   // through its centre (a proxy built from bricks is often symmetric but for a small part, which
@@ -451,10 +450,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
         const IcpResult coarse_twin = refine((camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp);
         const IcpResult refined = refine(coarse_twin.proxy_T_camera, search_icp_);
         if (same_pose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
-        Candidate candidate = Verify(frame, refined);
-        if (better(candidate, best)) best = candidate;
-        if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
-        if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
+        weigh(refined);
       }
     }
   }
