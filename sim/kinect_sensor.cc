@@ -1507,11 +1507,7 @@ struct KinectSensor::Impl {
     const bool vector = UseAvx512().load(std::memory_order_relaxed) && MMH_SENSOR_AVX512;
     std::fill(scan, scan + padded, 0);
     for (double source_x : sources) {
-      const auto shift = static_cast<float>(fx * source_x / disparity_scale);
-      // Pixels that see nothing never bound the scan.
-      const float none = (source_x > 0 ? 1.0f : -1.0f) * std::numeric_limits<float>::infinity();
-      SourceColumns(disparity, width, shift, none, us);
-      std::fill(us + width, us + padded, none);
+      SourceRow(disparity, width, fx, source_x, us);
 #if MMH_SENSOR_AVX512
       if (vector) {
         if (source_x > 0) {
