@@ -67,7 +67,6 @@ struct SessionJob {
 // Renders the session frame by frame (incremental mode: only what moves is re-cast) and hands
 // each frame to the tracker; nothing is stored but the tracker's results.
 void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOptions& tracker,
-                const track::TrajectorySmootherOptions& smoothing,
                 const track::SliderReaderOptions& slider, SessionJob& job,
                 const std::function<void()>& frame_done) {
   const auto start = Clock::now();
@@ -85,7 +84,6 @@ void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOption
       "simulated session", frames);
   track::TrackConfig config;
   config.tracker = tracker;
-  config.smoothing = smoothing;
   config.slider = slider;
   config.run.output_frame = track::OutputFrame::kTable;
   config.run.slider = job.annotation;
@@ -188,16 +186,15 @@ void RunOptions::Validate(const std::string& prefix) const {
 
 RunConfig RunConfig::FromConfig(const Config& config,
                                 const std::vector<std::string>& extra_sections) {
-  std::vector<std::string> sections = {"render",    "camera",  "scene",       "hand",
-                                       "sensor",    "motion",  "population",  "performance",
-                                       "annotator", "tracker", "smoothing",   "slider",
-                                       "montage",   "metrics", "error_model", "run"};
+  std::vector<std::string> sections = {"render",    "camera",      "scene",      "hand",
+                                       "sensor",    "motion",      "population", "performance",
+                                       "annotator", "tracker",     "slider",     "montage",
+                                       "metrics",   "error_model", "run"};
   sections.insert(sections.end(), extra_sections.begin(), extra_sections.end());
   config.RequireOnlySections(sections);
   RunConfig c;
   c.render = sim::RenderConfig::FromConfig(config);
   c.tracker = config.Get<track::ProxyTrackerOptions>("tracker");
-  c.smoothing = config.Get<track::TrajectorySmootherOptions>("smoothing");
   c.slider = config.Get<track::SliderReaderOptions>("slider");
   c.montage = config.Get<montage::ComposeOptions>("montage");
   c.metrics = config.Get<metrics::PoseErrorOptions>("metrics");
@@ -226,7 +223,6 @@ RunConfig RunConfig::FromConfig(const Config& config,
 nlohmann::json RunConfig::ToJson() const {
   nlohmann::json j = render.ToJson();
   j["tracker"] = mmh::ToJson(tracker);
-  j["smoothing"] = mmh::ToJson(smoothing);
   j["slider"] = mmh::ToJson(slider);
   j["montage"] = mmh::ToJson(montage);
   j["metrics"] = mmh::ToJson(metrics);
@@ -388,10 +384,8 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     // job, instead of starting another job and leaving the first one stalled mid-frame.
     tbb::parallel_for(0, workers, 1, [&](int) {
       for (int k = next++; k < static_cast<int>(order.size()); k = next++) {
-        tbb::this_task_arena::isolate([&] {
-          RunSession(render, config.tracker, config.smoothing, config.slider, jobs[order[k]],
-                     frame_done);
-        });
+        tbb::this_task_arena::isolate(
+            [&] { RunSession(render, config.tracker, config.slider, jobs[order[k]], frame_done); });
       }
     });
     const double sessions_seconds = SecondsSince(t0);

@@ -32,7 +32,6 @@
 #include "sim/story.h"
 #include "track/proxy_tracker.h"
 #include "track/slider_reader.h"
-#include "track/trajectory_smoother.h"
 
 namespace mmh::pipeline {
 
@@ -67,14 +66,12 @@ struct RunOptions {
 };
 
 // Every section of a run config: the render sections (sim/render_session.h; render.story,
-// render.animator and render.object choose the scenario), "tracker", "smoothing" and "slider"
-// (track/),
+// render.animator and render.object choose the scenario), "tracker" and "slider" (track/),
 // "montage" (montage::ComposeOptions), "metrics" (metrics::PoseErrorOptions), "error_model"
 // (pipeline/error_model.h) and "run". Unknown sections and keys are errors.
 struct RunConfig {
   sim::RenderConfig render;
   track::ProxyTrackerOptions tracker;
-  track::TrajectorySmootherOptions smoothing;  // of each recorded take's measured poses
   track::SliderReaderOptions slider;
   montage::ComposeOptions montage;
   metrics::PoseErrorOptions metrics;

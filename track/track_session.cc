@@ -25,11 +25,10 @@ void TrackRunOptions::Validate(const std::string& prefix) const {
 }
 
 TrackConfig TrackConfig::FromConfig(const Config& config) {
-  config.RequireOnlySections({"run", "tracker", "smoothing", "slider", "freenect"});
+  config.RequireOnlySections({"run", "tracker", "slider", "freenect"});
   TrackConfig c;
   c.run = config.Get<TrackRunOptions>("run");
   c.tracker = config.Get<ProxyTrackerOptions>("tracker");
-  c.smoothing = config.Get<TrajectorySmootherOptions>("smoothing");
   c.slider = config.Get<SliderReaderOptions>("slider");
   c.freenect = config.Get<FreenectOptions>("freenect");
   return c;
@@ -38,7 +37,6 @@ TrackConfig TrackConfig::FromConfig(const Config& config) {
 nlohmann::json TrackConfig::ToJson() const {
   return {{"run", mmh::ToJson(run)},
           {"tracker", mmh::ToJson(tracker)},
-          {"smoothing", mmh::ToJson(smoothing)},
           {"slider", mmh::ToJson(slider)},
           {"freenect", mmh::ToJson(freenect)}};
 }
@@ -107,7 +105,6 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
                      const std::function<void(int, int)>& progress) {
   config.run.Validate("run");
-  config.smoothing.Validate("smoothing");
   const bool slider_only = !config.run.proxy;
   if (slider_only) {
     if (!config.run.slider) {
@@ -178,34 +175,19 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
     run.summary.predicted += result.status == TrackStatus::kPredicted;
     run.summary.lost += result.status == TrackStatus::kLost;
     run.summary.detections += result.detected;
+    if (result.status != TrackStatus::kLost) {
+      Rigid3 pose = result.camera_T_proxy;
+      if (config.run.output_frame == OutputFrame::kTable && tracker->camera_T_table()) {
+        pose = tracker->camera_T_table()->Inverse() * pose;
+      }
+      run.trajectory.timestamps.push_back(frame.timestamp);
+      run.trajectory.poses.push_back(pose);
+    }
     if (progress) progress(run.summary.frames, source.size());
   }
   if (tracker) {
     run.camera_T_table = tracker->camera_T_table();
     run.table_plane = tracker->table_plane();
-    // The take is complete: its measured poses are smoothed (predicted and lost frames are not).
-    const size_t frames = run.frames.size();
-    std::vector<double> timestamps(frames);
-    std::vector<bool> measured(frames);
-    std::vector<Rigid3> poses(frames);
-    for (size_t i = 0; i < frames; ++i) {
-      timestamps[i] = run.frames[i].timestamp;
-      measured[i] = run.frames[i].status == TrackStatus::kTracked;
-      poses[i] = run.frames[i].camera_T_proxy;
-    }
-    run.smoothing = SmoothTrajectory(timestamps, measured, config.smoothing, &poses);
-    for (size_t i = 0; i < frames; ++i) {
-      TrackFrameResult& result = run.frames[i];
-      if (measured[i]) result.camera_T_proxy = poses[i];
-      if (result.status == TrackStatus::kLost) continue;
-      // The table frame is fixed once estimated, and no frame before it is tracked.
-      Rigid3 pose = result.camera_T_proxy;
-      if (config.run.output_frame == OutputFrame::kTable && run.camera_T_table) {
-        pose = run.camera_T_table->Inverse() * pose;
-      }
-      run.trajectory.timestamps.push_back(result.timestamp);
-      run.trajectory.poses.push_back(pose);
-    }
   } else {
     run.camera_T_table = slider_table.camera_T_table();
     run.table_plane = slider_table.plane();
@@ -277,13 +259,6 @@ std::vector<std::string> WriteTrackRun(const std::filesystem::path& out, const T
         {"inlier_share", run.table_plane->inlier_share},
         {"rms_distance_m", run.table_plane->rms_distance},
         {"planes_found", run.table_plane->candidates}};
-  }
-  if (!run.trajectory.empty()) {
-    summary["smoothing"] = {{"smoothed_frames", run.smoothing.measured},
-                            {"runs", run.smoothing.runs},
-                            {"breaks_at_jumps", run.smoothing.breaks},
-                            {"mean_change_deg", run.smoothing.mean_change_deg},
-                            {"mean_change_m", run.smoothing.mean_change}};
   }
   // Timings vary from run to run: they go to run.json, not here (same config, same bytes).
   summary.erase("seconds");

@@ -21,7 +21,6 @@
 #include "track/proxy_tracker.h"
 #include "track/setup.h"
 #include "track/slider_reader.h"
-#include "track/trajectory_smoother.h"
 
 namespace mmh::track {
 
@@ -64,12 +63,10 @@ struct TrackRunOptions {
   void Validate(const std::string& prefix) const;
 };
 
-// Every section of a track config: "run", "tracker", "smoothing", "slider", "freenect".
+// Every section of a track config: "run", "tracker", "slider", "freenect".
 struct TrackConfig {
   TrackRunOptions run;
   ProxyTrackerOptions tracker;
-  // Applied to the take's measured poses after the last frame (track/trajectory_smoother.h).
-  TrajectorySmootherOptions smoothing;
   SliderReaderOptions slider;
   FreenectOptions freenect;
 
@@ -89,7 +86,6 @@ struct TrackSummary {
 };
 
 struct TrackRun {
-  // One per frame; camera_T_proxy of the tracked frames is the smoothed pose (config.smoothing).
   std::vector<TrackFrameResult> frames;
   std::vector<SliderReading> slider;  // empty without slider reading
   // The poses of the frames not lost, in the output frame.
@@ -100,7 +96,6 @@ struct TrackRun {
   std::optional<Rigid3> camera_T_table;
   std::optional<TablePlane> table_plane;
   TrackSummary summary;
-  TrajectorySmootherSummary smoothing;
 };
 
 // Tracks every frame of `source` (progress(done, total or -1) after each). The setup is the
