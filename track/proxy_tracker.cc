@@ -48,6 +48,7 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(rival_drift, prefix + ".rival_drift");
   RequireNonNegative(seed_shift, prefix + ".seed_shift", "m");
   RequireNonNegative(seed_turn_deg, prefix + ".seed_turn_deg", "deg");
+  RequireNonNegative(slide_drop, prefix + ".slide_drop");
   RequireNonNegative(rival_threshold, prefix + ".rival_threshold");
   if (trusted_frames < 0) {
     ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
@@ -546,26 +547,50 @@ void ProxyTracker::SetRival(const std::optional<Rigid3>& proxy_T_rival, bool res
   proxy_T_rival_ = proxy_T_rival;
 }
 
-bool ProxyTracker::WeighRival(const RgbdFrame& frame, Candidate* chosen) {
-  const DetectionOptions& o = options_.detection;
-  if (o.rival_threshold <= 0 || !proxy_T_rival_ || !chosen->good) return false;
-  const double pi = std::numbers::pi;
-  const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
-  const Rigid3 camera_T_rival = camera_T_proxy * *proxy_T_rival_;
+ProxyTracker::Candidate ProxyTracker::RefineOnFrame(const RgbdFrame& frame,
+                                                    const Rigid3& camera_T_start) {
   // Refined on the detection's subsample, then scored on all of this frame's data (as the
   // tracked pose is).
   const size_t medium_scored = PrepareMediumData();
   const double skin = options_.verification.skin_distance;
   const IcpResult coarse =
-      AlignPointToPlane(*model_, detection_scratch_, medium_scored, skin, camera_T_rival.Inverse(),
+      AlignPointToPlane(*model_, detection_scratch_, medium_scored, skin, camera_T_start.Inverse(),
                         search_icp_, sample_matches_);
   IcpOptions final_icp = search_icp_;
   final_icp.max_iterations = 2;
   final_icp.start_distance = final_icp.end_distance;
   final_icp.shrink_iterations = 0;
-  const Candidate rival =
-      Verify(frame, AlignPointToPlane(*model_, data_, scored_, skin, coarse.proxy_T_camera,
-                                      final_icp, sample_matches_));
+  return Verify(frame, AlignPointToPlane(*model_, data_, scored_, skin, coarse.proxy_T_camera,
+                                         final_icp, sample_matches_));
+}
+
+bool ProxyTracker::CheckSlide(const RgbdFrame& frame, Candidate* chosen) {
+  const DetectionOptions& o = options_.detection;
+  if (!o.slide_check || o.seed_shift <= 0 || !chosen->good) return false;
+  const double score = chosen->Score();
+  const std::optional<double> reference = recent_score_;
+  recent_score_ = reference ? *reference + 0.1 * (score - *reference) : score;
+  if (o.slide_drop > 0 && (!reference || score >= *reference - o.slide_drop)) return false;
+  const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
+  const Eigen::Vector3d up = camera_T_table_->rotation * Eigen::Vector3d::UnitZ();
+  std::optional<Candidate> best;
+  for (double sign : {-1.0, 1.0}) {
+    const Candidate shifted = RefineOnFrame(
+        frame,
+        Rigid3(camera_T_proxy.rotation, camera_T_proxy.translation + sign * o.seed_shift * up));
+    if (shifted.good && (!best || shifted.Score() > best->Score())) best = shifted;
+  }
+  if (!best || best->Score() <= chosen->Score() + o.switch_margin) return false;
+  *chosen = *best;
+  return true;
+}
+
+bool ProxyTracker::WeighRival(const RgbdFrame& frame, Candidate* chosen) {
+  const DetectionOptions& o = options_.detection;
+  if (o.rival_threshold <= 0 || !proxy_T_rival_ || !chosen->good) return false;
+  const double pi = std::numbers::pi;
+  const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
+  const Candidate rival = RefineOnFrame(frame, camera_T_proxy * *proxy_T_rival_);
   const Rigid3 camera_T_refined = rival.icp.proxy_T_camera.Inverse();
   // Slid back onto the tracked pose: no twin here (this frame says nothing).
   if (RotationAngle(camera_T_refined.rotation, camera_T_proxy.rotation) <= pi / 4) return false;
@@ -596,6 +621,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     velocity_.reset();
     predicted_frames_ = 0;
     tracked_frames_ = 0;
+    recent_score_.reset();
     SetRival(std::nullopt, true);
     return result;
   };
@@ -687,9 +713,12 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
       std::optional<Candidate> detected = Detect(frame, predicted, light);
       const bool far = detected && RotationAngle(detected->icp.proxy_T_camera.rotation,
                                                  chosen->icp.proxy_T_camera.rotation) > pi / 4;
+      // A trusted track leaves for a twin only on the twin evidence (WeighRival).
+      const bool by_evidence = far && d.rival_threshold > 0 && tracked_frames_ >= d.trusted_frames;
       if (detected && detected->good &&
           (!chosen->good ||
-           detected->Score() > chosen->Score() + (far ? d.far_switch_margin : d.switch_margin))) {
+           (!by_evidence &&
+            detected->Score() > chosen->Score() + (far ? d.far_switch_margin : d.switch_margin)))) {
         chosen = detected;
         result.detected = true;
         SetRival(detection_rival_, far);
@@ -721,10 +750,12 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
                      : "no segment large enough for a detection";
     }
   }
+  // A pose moved by the slide check is a measurement, but no motion: the velocity restarts.
+  const bool slid = chosen && !result.detected && CheckSlide(frame, &*chosen);
   if (chosen && WeighRival(frame, &*chosen)) result.detected = true;
   if (chosen) {
     const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
-    if (last_ && !result.detected) {
+    if (last_ && !result.detected && !slid) {
       velocity_ = camera_T_proxy * last_->Inverse();
     } else {
       velocity_.reset();
@@ -749,6 +780,8 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
       if (velocity_) velocity_ = Interpolate(Rigid3::Identity(), *velocity_, 0.5);
       last_ = velocity_ ? *velocity_ * *last_ : *last_;
       ++predicted_frames_;
+      // Hidden, the proxy may be turned: continuity no longer tells it from its twins.
+      tracked_frames_ = 0;
       result.status = TrackStatus::kPredicted;
       result.camera_T_proxy = *last_;
       result.reason = why;

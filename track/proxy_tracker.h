@@ -64,7 +64,7 @@ struct DetectionOptions {
   double switch_margin = 0.05;
   // ... and far_switch_margin higher when it is more than 45 deg from the tracked pose (a verified
   // pose does not turn that far in a frame: such a switch is to a twin, or from one).
-  double far_switch_margin = 0.15;
+  double far_switch_margin = 0.3;
   // ... and within the detection, a candidate more than 45 deg from another wins over the one
   // nearer the prediction only when it scores far_switch_margin higher, once the track has been
   // measured for trusted_frames frames since its last loss (before that, a fresh detection may
@@ -77,11 +77,28 @@ struct DetectionOptions {
   // becomes the pose (0: off). A twin that explains the data a little better on many frames wins,
   // where one margin per check (far_switch_margin) either waits for a large difference or switches
   // on noise.
+  // Once the track is trusted (trusted_frames), a check's pose more than 45 deg from the tracked
+  // one does not replace it on one frame's score (far_switch_margin applies only before that):
+  // it becomes the rival, and the twin evidence decides (with rival_threshold 0, the margin
+  // decides as before trust). On a Mario take a light check switched into the half-turn twin on
+  // one frame that scored 0.16 above a pose the hand had degraded (51 frames lost to the twin).
   // Besides the prediction and the last pose, the prediction shifted by +-seed_shift [m] along the
   // table's normal and turned by +-seed_turn_deg [deg] about the table's x and y axes through the
   // model's centre are refined as candidates (0: not).
   double seed_shift = 0.012;
   double seed_turn_deg = 10.0;
+  // Slide check, every tracked frame: the tracked pose shifted by +-seed_shift along the table's
+  // normal is refined (as the rival is) and replaces it when it scores switch_margin higher. Seen
+  // from the side under the hand the Soldier's data hardly constrains its height, the
+  // constant-velocity prediction carries one frame's 5 mm of noise on, and the motion prior holds
+  // the pose there: it climbed 20 mm in three frames and stayed (or a check took its half-turn
+  // twin, equally high); the displaced seeds of the periodic check came up to 15 frames late.
+  bool slide_check = true;
+  // ... on the frames whose score falls more than slide_drop below the track's recent score (an
+  // exponential average over the last ~10 measured frames; 0: every frame). A slide costs the
+  // score (the true pose scored 1.21-1.23 on the take where the slid one fell from 1.16 to 1.0),
+  // and the check costs two refinements, 30 % of the frame's time when run on every frame.
+  double slide_drop = 0.02;
   double rival_drift = 0.03;
   double rival_threshold = 0.25;
 
@@ -106,6 +123,8 @@ struct DetectionOptions {
     v("trusted_frames", trusted_frames);
     v("seed_shift", seed_shift);
     v("seed_turn_deg", seed_turn_deg);
+    v("slide_check", slide_check);
+    v("slide_drop", slide_drop);
     v("rival_drift", rival_drift);
     v("rival_threshold", rival_threshold);
   }
@@ -259,6 +278,12 @@ class ProxyTracker {
   // Refines the rival on this frame, adds its evidence, and replaces *chosen by it when the
   // evidence suffices (returns true then).
   bool WeighRival(const RgbdFrame& frame, Candidate* chosen);
+  // The slide check (DetectionOptions::slide_check): replaces *chosen by its better displaced
+  // refinement along the table's normal (returns true then).
+  bool CheckSlide(const RgbdFrame& frame, Candidate* chosen);
+  // Refines camera_T_start on the detection's subsample, then for two iterations on all of this
+  // frame's data, and verifies it (the rival's and the slide check's refinement).
+  Candidate RefineOnFrame(const RgbdFrame& frame, const Rigid3& camera_T_start);
   // The global detection; `predicted` (the motion model's pose, when there is one) breaks ties.
   // `light`: only the motion model's seeds and the twins, no coarse hypotheses.
   std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted,
@@ -303,6 +328,9 @@ class ProxyTracker {
   std::optional<Rigid3> proxy_T_rival_;
   std::optional<Rigid3> detection_rival_;
   double rival_evidence_ = 0.0;
+  // The exponential average of the tracked poses' scores (the slide check's reference); nullopt
+  // after a loss.
+  std::optional<double> recent_score_;
   // options_.icp without the motion prior (detection, scoring).
   IcpOptions search_icp_;
   size_t scored_ = 0;
