@@ -744,7 +744,12 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     if (detected && detected->good) {
       chosen = detected;
       result.detected = true;
-      SetRival(detection_rival_, true);
+      // The twin evidence survives a detection that continues the track (the tracked pose failed
+      // its verification on a frame, as under the hand it often does), unless it restarts it or
+      // turns it onto a twin.
+      SetRival(detection_rival_,
+               !predicted || RotationAngle(detected->icp.proxy_T_camera.Inverse().rotation,
+                                           predicted->rotation) > pi / 4);
     } else if (why.empty()) {
       why = detected ? "no pose hypothesis verified (best: " + detected->reason + ")"
                      : "no segment large enough for a detection";
