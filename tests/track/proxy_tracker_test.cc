@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/config.h"
+#include "core/error.h"
 #include "metrics/tracking_metrics.h"
 #include "tests/track/sim_take.h"
 
@@ -175,6 +176,35 @@ TEST(ProxyTrackerTest, SoldierStoryTakesByFourAnimators) {
     EXPECT_GE(result.summary.success_rate, kStorySuccess);
     EXPECT_TRUE(result.summary.all_recovered);
     EXPECT_LE(result.summary.longest_failure, 15);
+  }
+}
+
+// Animator 1's Soldier story take 0, frames 700-849: seen from the side with the hand on its head,
+// the Soldier's height is hardly constrained by the data, and the constant-velocity prediction
+// carried one frame's noise on until the pose had climbed 11-19 mm up its vertical faces (frames
+// 783-784, scoring about 0.2 below the true pose). The slide check (detection.slide_check) refines
+// the pose shifted along the table's normal when the score drops and takes the better one.
+// Measured: 100 % within 5 deg and 1 cm (97.3 % without the slide check, 0.5 deg / 0.5 mm medians).
+TEST(ProxyTrackerTest, SoldierSideViewDoesNotSlideUpItsFaces) {
+  int take_frames = 0;
+  test_take::SimTake take = test_take::SoldierStorySession(
+      MMH_SOURCE_DIR, 1, 0, sim::RenderSession::kRecording, &take_frames);
+  ASSERT_GE(take_frames, 850);
+  const TakeResult result = TrackTake(take, 150, {}, 700);
+  EXPECT_GE(result.summary.success_rate, 0.99);
+  EXPECT_LE(result.summary.median_translation, 0.002);
+  EXPECT_TRUE(result.summary.all_recovered);
+}
+
+TEST(ProxyTrackerTest, SlideDropMustNotBeNegative) {
+  ProxyTrackerOptions options;
+  options.detection.slide_drop = -0.01;
+  try {
+    options.Validate("tracker");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tracker.detection.slide_drop"), std::string::npos)
+        << e.what();
   }
 }
 
