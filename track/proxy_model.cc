@@ -20,6 +20,7 @@ void ProxyModelOptions::Validate(const std::string& prefix) const {
   range(sample_spacing, 0.0002, 0.02, "sample_spacing");
   range(grid_resolution, 0.0005, 0.02, "grid_resolution");
   range(grid_margin, 0.005, 0.2, "grid_margin");
+  range(fine_distance, 0.0, 0.2, "fine_distance");
 }
 
 ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& options,
@@ -90,6 +91,8 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
   size_t cells = 1;
   for (int d = 0; d < 3; ++d) {
     dims_[d] = static_cast<int>(std::ceil((size[d] + 2 * options_.grid_margin) / resolution)) + 1;
+    dims_[d] = (dims_[d] + 3) / 4 * 4;
+    block_dims_[d] = dims_[d] / 4;
     cells *= dims_[d];
   }
   if (cells > (size_t{64} << 20)) {
@@ -101,7 +104,7 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
   // backward, each cell taking a neighbour's sample when that one is nearer to its centre. Two
   // double sweeps; the result is the true nearest sample or one within a fraction of a cell of it
   // (the ICP uses the sample's face plane, which such a neighbour shares).
-  grid_.assign(cells, -1);
+  std::vector<int32_t> grid(cells, -1);
   std::vector<float> best(cells, std::numeric_limits<float>::infinity());
   auto center_of = [&](int x, int y, int z) {
     return Eigen::Vector3f(grid_origin_ +
@@ -117,7 +120,7 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
     const float d = (points_[i] - center_of(x, y, z)).squaredNorm();
     if (d < best[c]) {
       best[c] = d;
-      grid_[c] = i;
+      grid[c] = i;
     }
   }
   auto sweep = [&](int direction) {
@@ -139,12 +142,12 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
                     nz >= dims_[2]) {
                   continue;
                 }
-                const int candidate = grid_[nz * sz + ny * sy + nx * sx];
-                if (candidate < 0 || candidate == grid_[c]) continue;
+                const int candidate = grid[nz * sz + ny * sy + nx * sx];
+                if (candidate < 0 || candidate == grid[c]) continue;
                 const float d = (points_[candidate] - center).squaredNorm();
                 if (d < best[c]) {
                   best[c] = d;
-                  grid_[c] = candidate;
+                  grid[c] = candidate;
                 }
               }
             }
@@ -156,6 +159,34 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
   for (int pass = 0; pass < 2; ++pass) {
     sweep(+1);
     sweep(-1);
+  }
+  // Blocks: fine where a cell lies within fine_distance of its sample, else coarse (the sample of
+  // the cell nearest each 2^3 group's centre, its cell (1, 1, 1)).
+  const float fine_squared = static_cast<float>(options_.fine_distance * options_.fine_distance);
+  blocks_.assign(static_cast<size_t>(block_dims_[0]) * block_dims_[1] * block_dims_[2], 0);
+  cells_.clear();
+  for (int bz = 0; bz < block_dims_[2]; ++bz) {
+    for (int by = 0; by < block_dims_[1]; ++by) {
+      for (int bx = 0; bx < block_dims_[0]; ++bx) {
+        const size_t corner = 4 * (bz * sz + by * sy + bx * sx);
+        bool fine = false;
+        for (int k = 0; k < 64 && !fine; ++k) {
+          fine = best[corner + (k >> 4) * sz + (k >> 2 & 3) * sy + (k & 3)] <= fine_squared;
+        }
+        const size_t b = (static_cast<size_t>(bz) * block_dims_[1] + by) * block_dims_[0] + bx;
+        blocks_[b] = static_cast<uint32_t>(cells_.size()) << 1 | (fine ? 1 : 0);
+        if (fine) {
+          for (int k = 0; k < 64; ++k) {
+            cells_.push_back(grid[corner + (k >> 4) * sz + (k >> 2 & 3) * sy + (k & 3)]);
+          }
+        } else {
+          for (int k = 0; k < 8; ++k) {
+            cells_.push_back(grid[corner + ((k >> 2) * 2 + 1) * sz + ((k >> 1 & 1) * 2 + 1) * sy +
+                                  (k & 1) * 2 + 1]);
+          }
+        }
+      }
+    }
   }
 }
 
