@@ -80,9 +80,11 @@ void SetAccuracy(benchmark::State& state, const Take& take,
 // first detection included, amortised over the take).
 void TrackTake(benchmark::State& state, const Take& take) {
   std::vector<std::optional<Rigid3>> estimates;
+  size_t grid_bytes = 0;
   for (auto _ : state) {
     state.PauseTiming();
     ProxyTracker tracker(take.model, "soldier", take.setup, ProxyTrackerOptions());
+    grid_bytes = tracker.model().grid_bytes();
     estimates.clear();
     state.ResumeTiming();
     for (const RgbdFrame& frame : take.frames) {
@@ -93,6 +95,7 @@ void TrackTake(benchmark::State& state, const Take& take) {
   }
   state.SetItemsProcessed(state.iterations() * kFrames);
   SetAccuracy(state, take, estimates);
+  state.counters["grid_MB"] = grid_bytes / 1e6;  // the model's closest-point grid
 }
 void BM_ProxyTracker(benchmark::State& state) { TrackTake(state, GetTake()); }
 BENCHMARK(BM_ProxyTracker)->Unit(benchmark::kMillisecond);

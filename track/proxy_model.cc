@@ -168,21 +168,22 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
   for (int bz = 0; bz < block_dims_[2]; ++bz) {
     for (int by = 0; by < block_dims_[1]; ++by) {
       for (int bx = 0; bx < block_dims_[0]; ++bx) {
+        // Cell (x, y, z) of the block, each 0..3; the block's k-th fine entry is cell
+        // (k & 3, k >> 2 & 3, k >> 4), its k-th coarse entry cell (1, 1, 1) of 2^3 group
+        // (k & 1, k >> 1 & 1, k >> 2), as Closest reads them.
         const size_t corner = 4 * (bz * sz + by * sy + bx * sx);
+        auto cell = [&](int x, int y, int z) { return corner + z * sz + y * sy + x; };
         bool fine = false;
         for (int k = 0; k < 64 && !fine; ++k) {
-          fine = best[corner + (k >> 4) * sz + (k >> 2 & 3) * sy + (k & 3)] <= fine_squared;
+          fine = best[cell(k & 3, k >> 2 & 3, k >> 4)] <= fine_squared;
         }
         const size_t b = (static_cast<size_t>(bz) * block_dims_[1] + by) * block_dims_[0] + bx;
         blocks_[b] = static_cast<uint32_t>(cells_.size()) << 1 | (fine ? 1 : 0);
         if (fine) {
-          for (int k = 0; k < 64; ++k) {
-            cells_.push_back(grid[corner + (k >> 4) * sz + (k >> 2 & 3) * sy + (k & 3)]);
-          }
+          for (int k = 0; k < 64; ++k) cells_.push_back(grid[cell(k & 3, k >> 2 & 3, k >> 4)]);
         } else {
           for (int k = 0; k < 8; ++k) {
-            cells_.push_back(grid[corner + ((k >> 2) * 2 + 1) * sz + ((k >> 1 & 1) * 2 + 1) * sy +
-                                  (k & 1) * 2 + 1]);
+            cells_.push_back(grid[cell(2 * (k & 1) + 1, 2 * (k >> 1 & 1) + 1, 2 * (k >> 2) + 1)]);
           }
         }
       }

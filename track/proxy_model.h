@@ -54,7 +54,8 @@ class ProxyModel {
   // #S: the mesh face each sample lies on (for its colour).
   const std::vector<int>& sample_faces() const { return sample_faces_; }
 
-  // Index of the sample nearest to `model_p` (up to half a grid cell), or -1 outside the grid.
+  // Index of the sample nearest to the centre of `model_p`'s cell (in the coarse level: of a cell
+  // of its 2^3 group), or -1 outside the grid.
   int Closest(const Eigen::Vector3f& model_p) const {
     const Eigen::Vector3f g = (model_p - grid_origin_) * inverse_resolution_;
     const int x = static_cast<int>(g.x()), y = static_cast<int>(g.y()), z = static_cast<int>(g.z());
@@ -70,7 +71,7 @@ class ProxyModel {
     if (block & 1) return cells_[first + ((z & 3) << 4 | (y & 3) << 2 | (x & 3))];
     return cells_[first + ((z & 2) << 1 | (y & 2) | (x & 2) >> 1)];
   }
-  // The grid's size [bytes] (for the benchmark's report).
+  // The grid's size [bytes] (bench_track reports it).
   size_t grid_bytes() const {
     return blocks_.size() * sizeof(uint32_t) + cells_.size() * sizeof(int32_t);
   }

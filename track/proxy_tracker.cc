@@ -564,12 +564,16 @@ ProxyTracker::Candidate ProxyTracker::RefineOnFrame(const RgbdFrame& frame,
                                          final_icp, sample_matches_));
 }
 
+// Weight of a frame in the slide check's recent score (an exponential average over about the last
+// 1 / weight = 10 measured frames).
+constexpr double kRecentScoreWeight = 0.1;
+
 bool ProxyTracker::CheckSlide(const RgbdFrame& frame, Candidate* chosen) {
   const DetectionOptions& o = options_.detection;
   if (!o.slide_check || o.seed_shift <= 0 || !chosen->good) return false;
   const double score = chosen->Score();
   const std::optional<double> reference = recent_score_;
-  recent_score_ = reference ? *reference + 0.1 * (score - *reference) : score;
+  recent_score_ = reference ? *reference + kRecentScoreWeight * (score - *reference) : score;
   if (o.slide_drop > 0 && (!reference || score >= *reference - o.slide_drop)) return false;
   const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
   const Eigen::Vector3d up = camera_T_table_->rotation * Eigen::Vector3d::UnitZ();
