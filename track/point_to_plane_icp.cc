@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "track/internal/pose_update.h"
 
 namespace mmh::track {
 
@@ -47,17 +48,14 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
                             size_t scored, double extra_distance, const Rigid3& proxy_T_camera,
                             const IcpOptions& options, std::span<const uint8_t> sample_matches) {
   IcpResult result;
-  Eigen::Matrix3d rotation = proxy_T_camera.rotation.normalized().toRotationMatrix();
-  Eigen::Vector3d translation = proxy_T_camera.translation;
-  const Eigen::Matrix3d start_rotation = rotation;
-  const Eigen::Vector3d start_translation = translation;
-  // Prior weights (see IcpOptions::prior_rotation_deg).
-  const double prior_r =
-      options.prior_rotation_deg > 0
-          ? std::pow(options.huber / (options.prior_rotation_deg * M_PI / 180), 2)
-          : 0.0;
-  const double prior_t =
-      options.prior_translation > 0 ? std::pow(options.huber / options.prior_translation, 2) : 0.0;
+  internal::PoseUpdate update;
+  update.rotation = proxy_T_camera.rotation.normalized().toRotationMatrix();
+  update.translation = proxy_T_camera.translation;
+  update.start_rotation = update.rotation;
+  update.start_translation = update.translation;
+  update.prior_rotation =
+      internal::PriorWeight(options.huber, options.prior_rotation_deg * M_PI / 180);
+  update.prior_translation = internal::PriorWeight(options.huber, options.prior_translation);
   const auto& model_points = model.points();
   const auto& model_normals = model.normals();
   const float huber = static_cast<float>(options.huber);
@@ -67,8 +65,8 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
   const uint8_t* matches = sample_matches.data();
   for (int k = 0; k < options.max_iterations; ++k) {
     const float limit = DistanceAt(options, k);
-    const Eigen::Matrix3f r = rotation.cast<float>();
-    const Eigen::Vector3f t = translation.cast<float>();
+    const Eigen::Matrix3f r = update.rotation.cast<float>();
+    const Eigen::Vector3f t = update.translation.cast<float>();
     // Normal equations J^T W J xi = -J^T W r with J = [s x n, n] (xi = rotation, translation).
     Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
@@ -109,41 +107,18 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
     g += gf.cast<double>();
     result.iterations = k + 1;
     if (used < 6) break;
-    if (prior_r > 0 || prior_t > 0) {
-      // The deviation from the start, log(T T_start^-1) to first order: a left update exp(xi) T
-      // adds xi to it. Cost 1/2 (e + xi)^T W (e + xi): H += W, g += W e.
-      const Eigen::Matrix3d deviation = rotation * start_rotation.transpose();
-      const Eigen::AngleAxisd angle_axis(deviation);
-      const Eigen::Vector3d e_r = angle_axis.angle() * angle_axis.axis();
-      const Eigen::Vector3d e_t = translation - deviation * start_translation;
-      for (int a = 0; a < 3; ++a) {
-        h(a, a) += prior_r;
-        g(a) += prior_r * e_r(a);
-        h(3 + a, 3 + a) += prior_t;
-        g(3 + a) += prior_t * e_t(a);
-      }
-    }
-    // A small damping keeps a degenerate view (a single face) from a wild step.
-    h.diagonal().array() += 1e-9 * used;
-    const Eigen::Matrix<double, 6, 1> xi = -h.ldlt().solve(g);
-    if (!xi.allFinite()) break;
-    const Eigen::Vector3d omega = xi.head<3>();
-    const double angle = omega.norm();
-    const Eigen::Matrix3d step = angle > 0
-                                     ? Eigen::AngleAxisd(angle, omega / angle).toRotationMatrix()
-                                     : Eigen::Matrix3d::Identity();
-    rotation = step * rotation;
-    translation = step * translation + xi.tail<3>();
+    double angle = 0.0, shift = 0.0;
+    if (!update.Apply(h, g, used, &angle, &shift)) break;
     if (k + 1 >= options.shrink_iterations && angle < options.min_rotation &&
-        xi.tail<3>().norm() < options.min_translation) {
+        shift < options.min_translation) {
       break;
     }
   }
   // Re-orthonormalise and score.
-  const Eigen::Quaterniond q = Eigen::Quaterniond(rotation).normalized();
-  result.proxy_T_camera = Rigid3(q, translation);
+  const Eigen::Quaterniond q = Eigen::Quaterniond(update.rotation).normalized();
+  result.proxy_T_camera = Rigid3(q, update.translation);
   const Eigen::Matrix3f r = q.toRotationMatrix().cast<float>();
-  const Eigen::Vector3f t = translation.cast<float>();
+  const Eigen::Vector3f t = update.translation.cast<float>();
   const float inlier = static_cast<float>(options.inlier_distance);
   const float extra_inlier = std::min(inlier, extra);
   double sum = 0.0;

@@ -65,6 +65,11 @@ ProxyModel::ProxyModel(const TriangleMesh& mesh, const ProxyModelOptions& option
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (const auto& p : points_) sum += p.cast<double>();
   centroid_ = (sum / static_cast<double>(points_.size())).cast<float>();
+  sample_columns_.resize(static_cast<Eigen::Index>(points_.size()), 6);
+  for (size_t i = 0; i < points_.size(); ++i) {
+    sample_columns_.row(static_cast<Eigen::Index>(i)) << points_[i].transpose(),
+        normals_[i].transpose();
+  }
   // Sparse subset: one sample per 4 mm cell and normal direction (the dominant axis and its sign,
   // so that both sides of a thin part keep samples).
   {

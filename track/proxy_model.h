@@ -51,6 +51,8 @@ class ProxyModel {
   // #S by 3 sample positions and unit outward normals in the model frame.
   const std::vector<Eigen::Vector3f>& points() const { return points_; }
   const std::vector<Eigen::Vector3f>& normals() const { return normals_; }
+  // #S by 6: the same, x y z nx ny nz, one contiguous column each (for loops that vectorise).
+  const Eigen::Matrix<float, Eigen::Dynamic, 6>& sample_columns() const { return sample_columns_; }
   // #S: the mesh face each sample lies on (for its colour).
   const std::vector<int>& sample_faces() const { return sample_faces_; }
 
@@ -89,6 +91,7 @@ class ProxyModel {
   ProxyModelOptions options_;
   std::vector<Eigen::Vector3f> points_;
   std::vector<Eigen::Vector3f> normals_;
+  Eigen::Matrix<float, Eigen::Dynamic, 6> sample_columns_;
   std::vector<int> sample_faces_;
   std::vector<int> sparse_;
   Eigen::Vector3f grid_origin_;

@@ -19,6 +19,7 @@
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 #include "track/point_to_plane_icp.h"
+#include "track/projective_refinement.h"
 #include "track/proxy_model.h"
 #include "track/segmentation.h"
 #include "track/setup.h"
@@ -202,6 +203,7 @@ struct ProxyTrackerOptions {
   SegmentationOptions segmentation;
   ProxyModelOptions model;
   IcpOptions icp = TrackingIcpOptions();
+  ProjectiveOptions projective;
   DetectionOptions detection;
   VerificationOptions verification;
 
@@ -211,6 +213,7 @@ struct ProxyTrackerOptions {
     v("segmentation", segmentation);
     v("model", model);
     v("icp", icp);
+    v("projective", projective);
     v("detection", detection);
     v("verification", verification);
   }

@@ -9,8 +9,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <optional>
+#include <random>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -19,6 +24,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "metrics/tracking_metrics.h"
+#include "tests/test_util.h"
 #include "tests/track/sim_take.h"
 
 namespace mmh::track {
@@ -159,11 +165,12 @@ TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
 // tracker, animators 0 and 3): the first 200 frames of each (marching in front of the castle,
 // turning, the hand on the figure's head). Thresholds: the issue's median translation (2 mm) and
 // every loss recovered within 15 frames; the median rotation and the share within 5 deg and 1 cm
-// are guarded below the issue's 1 deg and 99 % (measured 1.6-1.7 deg and 96.7-100 %): seen from the
-// side the Soldier shows the camera a 32 mm wide strip under the hand (docs/tracker.md, "Known
-// weaknesses").
+// are guarded below the issue's 1 deg and 99 % (measured 1.01-1.21 deg and 95.5-100 %; 1.6-1.7 deg
+// before the projective refinement): these opening stretches are the story's hardest, seen from
+// the side the Soldier shows the camera a 32 mm wide strip under the hand (docs/tracker.md, "Known
+// weaknesses"). Whole takes meet the issue's median (docs/tracker.md, "Whole takes").
 TEST(ProxyTrackerTest, SoldierStoryTakesByFourAnimators) {
-  constexpr double kStoryMedianRotationDeg = 2.0;
+  constexpr double kStoryMedianRotationDeg = 1.3;
   constexpr double kStorySuccess = 0.95;
   for (const auto& [animator, take_index] : {std::pair{1, 0}, {2, 2}, {4, 1}, {5, 2}}) {
     int take_frames = 0;
@@ -249,6 +256,23 @@ TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
     ProxyTracker tracker(take.model(), "soldier", take.Setup(),
                          config.Get<ProxyTrackerOptions>("tracker"));
     int ok = 0;
+    std::vector<double> crb_draws, truth_fit, ideal_fit[2];
+    std::unique_ptr<test_take::SimTake> clean;
+    if (std::getenv("MMH_SURVEY_CRB")) {
+      // The same take without noise and lattice: each pixel's true surface point.
+      const test_util::TempDir dir;
+      nlohmann::json clean_json = nlohmann::json::parse(
+          std::ifstream(std::string(MMH_SOURCE_DIR) + "/" +
+                        (story_config ? story_config : "configs/study_soldier.json")));
+      clean_json["sensor"]["noise"] = false;
+      clean_json["sensor"]["quantise"] = false;
+      const std::filesystem::path clean_file = dir.path() / "clean.json";
+      test_util::WriteText(clean_file, clean_json.dump());
+      int unused = 0;
+      clean = std::make_unique<test_take::SimTake>(test_take::SoldierStorySession(
+          MMH_SOURCE_DIR, animator, take_index, sim::RenderSession::kRecording, &unused,
+          std::filesystem::relative(clean_file, MMH_SOURCE_DIR).string()));
+    }
     std::vector<std::optional<Rigid3>> estimates;
     std::vector<Rigid3> truths;
     for (int i = first; i < first + frames; ++i) {
@@ -276,6 +300,114 @@ TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
                     1000 * (table_T_estimate.translation - table_T_truth.translation).y(),
                     1000 * (table_T_estimate.translation - table_T_truth.translation).z(), x.x(),
                     x.y());
+      }
+      if (std::getenv("MMH_SURVEY_CRB")) {
+        // Cramer-Rao bound of the rotation from this frame's segmented points at the true pose:
+        // each point's depth along its ray has the sensor's axial noise plus the lattice's
+        // step^2 / 12; its point-to-plane residual has that times |n . ray|.
+        const auto& sensor = take.config().sensor;
+        const Rigid3 proxy_T_camera = truth.Inverse();
+        Eigen::Matrix<double, 6, 6> fisher = Eigen::Matrix<double, 6, 6>::Zero();
+        int used = 0;
+        for (const Eigen::Vector3f& pf : tracker.last_segmentation().points) {
+          const Eigen::Vector3d p = pf.cast<double>();
+          const Eigen::Vector3d q = proxy_T_camera * p;
+          const int s = tracker.model().Closest(q.cast<float>());
+          if (s < 0) continue;
+          const Eigen::Vector3d n_model = tracker.model().normals()[s].cast<double>();
+          if (std::abs(n_model.dot(q - tracker.model().points()[s].cast<double>())) > 0.004)
+            continue;
+          const Eigen::Vector3d n = truth.rotation * n_model;
+          const Eigen::Vector3d ray = p.normalized();
+          const double cos_incidence = std::min(1.0, std::abs(n.dot(ray)));
+          const double theta = std::acos(cos_incidence);
+          const double z = p.z();
+          const double step = z * z /
+                              (sensor.calibration.subpixel_steps *
+                               sensor.calibration.ir_focal_length * sensor.calibration.baseline);
+          const double sigma_depth =
+              std::hypot(sensor.axial.Sigma(z, theta), step / std::sqrt(12.0));
+          const double sigma = sigma_depth * std::max(cos_incidence, 0.05);
+          Eigen::Matrix<double, 6, 1> g;
+          g << p.cross(n), n;
+          fisher += g * g.transpose() / (sigma * sigma);
+          ++used;
+        }
+        const Eigen::Matrix3d cov = fisher.inverse().topLeftCorner<3, 3>();
+        const Eigen::Matrix3d chol = cov.llt().matrixL();
+        static std::mt19937_64 random(1);
+        std::normal_distribution<double> normal;
+        for (int k = 0; k < 64; ++k) {
+          const Eigen::Vector3d w(normal(random), normal(random), normal(random));
+          crb_draws.push_back((chol * w).norm() * 180 / M_PI);
+        }
+        // The fit with ideal correspondences: each point's pixel on the noise-free frame (the
+        // surface point it measures) with that point's model normal; IRLS (Huber 3 mm) on
+        // n . (R p + t - p0), unweighted and with the ML weights 1 / sigma^2.
+        {
+          const RgbdFrame clean_frame = clean->Render(i);
+          const auto& in = clean_frame.depth_intrinsics;
+          std::vector<Eigen::Vector3d> ps, p0s, ns;
+          std::vector<double> sig;
+          for (const Eigen::Vector3f& pf : tracker.last_segmentation().points) {
+            const Eigen::Vector3d p = pf.cast<double>();
+            const int u = static_cast<int>(std::lround(in.fx * p.x() / p.z() + in.cx));
+            const int v = static_cast<int>(std::lround(in.fy * p.y() / p.z() + in.cy));
+            if (u < 0 || v < 0 || u >= in.width || v >= in.height) continue;
+            const double z0 = clean_frame.DepthMetres(u, v);
+            if (z0 <= 0) continue;
+            const Eigen::Vector3d p0((u - in.cx) * z0 / in.fx, (v - in.cy) * z0 / in.fy, z0);
+            const Eigen::Vector3d q0 = proxy_T_camera * p0;
+            const int s0 = tracker.model().Closest(q0.cast<float>());
+            if (s0 < 0) continue;
+            if ((q0 - tracker.model().points()[s0].cast<double>()).norm() > 0.003) continue;
+            const Eigen::Vector3d n = truth.rotation * tracker.model().normals()[s0].cast<double>();
+            const double c = std::abs(n.dot(p0.normalized()));
+            const double step = z0 * z0 /
+                                (sensor.calibration.subpixel_steps *
+                                 sensor.calibration.ir_focal_length * sensor.calibration.baseline);
+            ps.push_back(p);
+            p0s.push_back(p0);
+            ns.push_back(n);
+            sig.push_back(std::hypot(sensor.axial.Sigma(z0, std::acos(std::min(c, 1.0))),
+                                     step / std::sqrt(12.0)) *
+                          std::max(c, 0.05));
+          }
+          for (int ml = 0; ml < 2; ++ml) {
+            Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+            Eigen::Vector3d t = Eigen::Vector3d::Zero();
+            for (int it = 0; it < 6; ++it) {
+              Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+              Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+              for (size_t k = 0; k < ps.size(); ++k) {
+                const Eigen::Vector3d x = R * ps[k] + t;
+                const double r = ns[k].dot(x - p0s[k]);
+                const double scale = ml ? sig[k] : 0.003;
+                const double huber = ml ? 1.5 * sig[k] : 0.003;
+                double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
+                w /= scale * scale;
+                Eigen::Matrix<double, 6, 1> g;
+                g << x.cross(ns[k]), ns[k];
+                H += w * g * g.transpose();
+                b -= w * g * r;
+              }
+              const Eigen::Matrix<double, 6, 1> d = H.ldlt().solve(b);
+              const Eigen::Vector3d w3 = d.head<3>();
+              const Eigen::Matrix3d dR =
+                  w3.norm() > 0 ? Eigen::AngleAxisd(w3.norm(), w3.normalized()).toRotationMatrix()
+                                : Eigen::Matrix3d::Identity();
+              R = dR * R;
+              t = dR * t + d.tail<3>();
+            }
+            ideal_fit[ml].push_back(Eigen::AngleAxisd(R).angle() * 180 / M_PI);
+          }
+        }
+        const auto from_truth = tracker.ScorePose(frame, truth);
+        truth_fit.push_back(RotationAngle(from_truth.camera_T_proxy.rotation, truth.rotation) *
+                            180 / M_PI);
+        if (std::getenv("MMH_SURVEY_ALL"))
+          std::printf("crb %d used %d rms %.2f deg\n", i, used,
+                      std::sqrt(cov.trace()) * 180 / M_PI);
       }
       if (success) continue;
       if (std::getenv("MMH_SURVEY_BRIEF")) {
@@ -329,6 +461,19 @@ TEST(ProxyTrackerTest, DISABLED_SoldierStorySurvey) {
           at_truth.inlier_share, at_truth.free_space_violation, at_truth.good, r.reason.c_str());
     }
     std::printf("== success %.4f (%d of %d)\n", static_cast<double>(ok) / frames, ok, frames);
+    if (!crb_draws.empty()) {
+      std::nth_element(crb_draws.begin(), crb_draws.begin() + crb_draws.size() / 2,
+                       crb_draws.end());
+      std::printf("== crb median rotation %.3f deg\n", crb_draws[crb_draws.size() / 2]);
+      std::nth_element(truth_fit.begin(), truth_fit.begin() + truth_fit.size() / 2,
+                       truth_fit.end());
+      std::printf("== fit from the truth: median rotation %.3f deg\n",
+                  truth_fit[truth_fit.size() / 2]);
+      for (auto& f : ideal_fit) {
+        std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
+        std::printf("== ideal correspondences: median rotation %.3f deg\n", f[f.size() / 2]);
+      }
+    }
     const auto points = metrics::MetricPoints(take.model());
     const metrics::PoseErrorOptions metric_options;
     const metrics::TrackingSummary summary = metrics::SummarizeTracking(
