@@ -766,7 +766,8 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   if (chosen) {
     // The reported pose is the projective refinement of the chosen one; the motion model, the
     // background and the checks keep the closest-point fit they were tuned on (refining that too
-    // lost 0.6 points of frames within 5 deg and 1 cm on four Soldier takes: docs/tracker.md).
+    // lost 0.3-0.6 points of frames within 5 deg and 1 cm on four Soldier takes and made a
+    // 20-frame failure: docs/tracker.md).
     Rigid3 camera_T_reported = chosen->icp.proxy_T_camera.Inverse();
     if (options_.projective.iterations > 0) {
       camera_T_reported =
