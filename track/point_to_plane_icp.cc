@@ -48,14 +48,8 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
                             size_t scored, double extra_distance, const Rigid3& proxy_T_camera,
                             const IcpOptions& options, std::span<const uint8_t> sample_matches) {
   IcpResult result;
-  internal::PoseUpdate update;
-  update.rotation = proxy_T_camera.rotation.normalized().toRotationMatrix();
-  update.translation = proxy_T_camera.translation;
-  update.start_rotation = update.rotation;
-  update.start_translation = update.translation;
-  update.prior_rotation =
-      internal::PriorWeight(options.huber, options.prior_rotation_deg * M_PI / 180);
-  update.prior_translation = internal::PriorWeight(options.huber, options.prior_translation);
+  internal::PoseUpdate update(proxy_T_camera, options.huber,
+                              options.prior_rotation_deg * M_PI / 180, options.prior_translation);
   const auto& model_points = model.points();
   const auto& model_normals = model.normals();
   const float huber = static_cast<float>(options.huber);
@@ -67,13 +61,7 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
     const float limit = DistanceAt(options, k);
     const Eigen::Matrix3f r = update.rotation.cast<float>();
     const Eigen::Vector3f t = update.translation.cast<float>();
-    // Normal equations J^T W J xi = -J^T W r with J = [s x n, n] (xi = rotation, translation).
-    Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    // Accumulate in float blocks of 256 points to keep the sums exact enough and fast.
-    Eigen::Matrix<float, 6, 6> hf = Eigen::Matrix<float, 6, 6>::Zero();
-    Eigen::Matrix<float, 6, 1> gf = Eigen::Matrix<float, 6, 1>::Zero();
-    int used = 0, block = 0;
+    internal::NormalEquations equations(huber);
     const size_t fitted = options.fit_extra_points ? points.size() : scored;
     for (size_t i = 0; i < fitted; ++i) {
       const Eigen::Vector3f rp = r * points[i];
@@ -87,28 +75,12 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
       const float max_distance = i < scored ? limit : std::min(limit, extra);
       if (d.squaredNorm() > max_distance * max_distance) continue;
       const float residual = n.dot(d);
-      const float a = std::abs(residual);
-      const float w = a <= huber ? 1.0f : huber / a;
-      Eigen::Matrix<float, 6, 1> j;
-      j.head<3>() = s.cross(n);
-      j.tail<3>() = n;
-      hf.noalias() += (w * j) * j.transpose();
-      gf.noalias() += (w * residual) * j;
-      ++used;
-      if (++block == 256) {
-        h += hf.cast<double>();
-        g += gf.cast<double>();
-        hf.setZero();
-        gf.setZero();
-        block = 0;
-      }
+      equations.Add(s, n, residual);
     }
-    h += hf.cast<double>();
-    g += gf.cast<double>();
     result.iterations = k + 1;
-    if (used < 6) break;
+    if (equations.used() < 6) break;
     double angle = 0.0, shift = 0.0;
-    if (!update.Apply(h, g, used, &angle, &shift)) break;
+    if (!update.Apply(equations, &angle, &shift)) break;
     if (k + 1 >= options.shrink_iterations && angle < options.min_rotation &&
         shift < options.min_translation) {
       break;

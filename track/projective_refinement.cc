@@ -32,6 +32,8 @@ namespace {
 // sample nearest the camera (-1: none).
 class SampleBuffer {
  public:
+  static constexpr size_t kSpareSlots = 16;  // a power of 2
+
   // The window [x0, x1] x [y0, y1] of an image with `intrinsics`.
   SampleBuffer(const PinholeIntrinsics& intrinsics, int x0, int y0, int x1, int y1)
       : x0_(x0), y0_(y0), width_(x1 - x0 + 1), height_(y1 - y0 + 1) {
@@ -44,11 +46,12 @@ class SampleBuffer {
   void Render(const ProxyModel& model, const Eigen::Matrix3f& camera_R_proxy,
               const Eigen::Vector3f& camera_t_proxy) {
     const size_t size = static_cast<size_t>(width_) * height_;
-    // One more slot than pixels: the samples not drawn go there, so that the z-buffer pass has no
-    // branch to mispredict (whether a sample faces the camera, and whether it is nearer, vary
-    // from sample to sample).
-    depth_.assign(size + 1, std::numeric_limits<float>::infinity());
-    sample_.assign(size + 1, -1);
+    // kSpareSlots more slots than pixels: the samples not drawn go there, so that the z-buffer pass
+    // has no branch to mispredict (whether a sample faces the camera, and whether it is nearer,
+    // vary from sample to sample); spread over several slots, they do not wait for each other's
+    // store to the same one.
+    depth_.assign(size + kSpareSlots, std::numeric_limits<float>::infinity());
+    sample_.assign(size + kSpareSlots, -1);
     const size_t count = model.points().size();
     // Two passes: the first, free of branches and scatter, vectorises (the facing test, the
     // projection and the window test per sample); the second z-buffers the samples it kept.
@@ -88,7 +91,8 @@ class SampleBuffer {
       const bool keep = (facing < 0) & (qz > 0) & (x >= 0) & (y >= 0) & (x < width) & (y < height);
       const int column = static_cast<int>(std::min(std::max(x, 0.0f), width - 1));
       const int row = static_cast<int>(std::min(std::max(y, 0.0f), height - 1));
-      pixel[c] = keep ? row * stride + column : static_cast<int>(size);
+      pixel[c] = keep ? row * stride + column
+                      : static_cast<int>(size) + static_cast<int>(c & (kSpareSlots - 1));
       depth[c] = qz;
     }
     for (size_t c = 0; c < count; ++c) {
@@ -126,7 +130,7 @@ class SampleBuffer {
   float fx_, fy_, cx_, cy_;
   std::vector<float> depth_;
   std::vector<int> sample_;
-  // Per model sample: its pixel in the window (the extra slot: not drawn) and depth [m].
+  // Per model sample: its pixel in the window (a spare slot: not drawn) and depth [m].
   std::vector<int> pixel_;
   std::vector<float> z_;
 };
@@ -137,14 +141,8 @@ Rigid3 RefineProjective(const ProxyModel& model, const PinholeIntrinsics& intrin
                         std::span<const Eigen::Vector3f> points, size_t scored,
                         double extra_distance, const Rigid3& proxy_T_camera,
                         const ProjectiveOptions& options, std::span<const uint8_t> sample_matches) {
-  internal::PoseUpdate update;
-  update.rotation = proxy_T_camera.rotation.normalized().toRotationMatrix();
-  update.translation = proxy_T_camera.translation;
-  update.start_rotation = update.rotation;
-  update.start_translation = update.translation;
-  update.prior_rotation =
-      internal::PriorWeight(options.huber, options.prior_rotation_deg * M_PI / 180);
-  update.prior_translation = internal::PriorWeight(options.huber, options.prior_translation);
+  internal::PoseUpdate update(proxy_T_camera, options.huber,
+                              options.prior_rotation_deg * M_PI / 180, options.prior_translation);
   scored = std::min(scored, points.size());
   // Each point's pixel (the points were measured at pixels, so the projection rounds exactly), and
   // the window the scored points span, one pixel wider for the neighbours' samples. Extra points
@@ -187,13 +185,7 @@ Rigid3 RefineProjective(const ProxyModel& model, const PinholeIntrinsics& intrin
     const Eigen::Matrix3f r = update.rotation.cast<float>();
     const Eigen::Vector3f t = update.translation.cast<float>();
     if (render) buffer.Render(model, r.transpose(), -(r.transpose() * t));
-    // Normal equations of the residuals n . (R p + t - s), J = [s x n, n], Huber weights, summed
-    // in float over blocks of 256 points (as AlignPointToPlane does).
-    Eigen::Matrix<double, 6, 6> h = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> g = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Matrix<float, 6, 6> hf = Eigen::Matrix<float, 6, 6>::Zero();
-    Eigen::Matrix<float, 6, 1> gf = Eigen::Matrix<float, 6, 1>::Zero();
-    int used = 0, block = 0;
+    internal::NormalEquations equations(huber);
     for (size_t i = 0; i < points.size(); ++i) {
       if (pixels[i].x() < 0) continue;
       const int c = buffer.At(pixels[i].x(), pixels[i].y());
@@ -206,27 +198,11 @@ Rigid3 RefineProjective(const ProxyModel& model, const PinholeIntrinsics& intrin
       const Eigen::Vector3f& n = model_normals[c];
       const float residual = n.dot(d);
       if (std::abs(residual) > max_residual) continue;
-      const float a = std::abs(residual);
-      const float w = a <= huber ? 1.0f : huber / a;
-      Eigen::Matrix<float, 6, 1> j;
-      j.head<3>() = s.cross(n);
-      j.tail<3>() = n;
-      hf.noalias() += (w * j) * j.transpose();
-      gf.noalias() += (w * residual) * j;
-      ++used;
-      if (++block == 256) {
-        h += hf.cast<double>();
-        g += gf.cast<double>();
-        hf.setZero();
-        gf.setZero();
-        block = 0;
-      }
+      equations.Add(s, n, residual);
     }
-    h += hf.cast<double>();
-    g += gf.cast<double>();
-    if (used < 6) break;
+    if (equations.used() < 6) break;
     double angle = 0.0, shift = 0.0;
-    if (!update.Apply(h, g, used, &angle, &shift)) break;
+    if (!update.Apply(equations, &angle, &shift)) break;
     if (angle < options.min_rotation && shift < options.min_translation) break;
     // The z-buffer is drawn again only when the step moved some part of the model by more than
     // rerender_px in the image; otherwise the correspondences stay and only their planes move.
