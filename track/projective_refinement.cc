@@ -153,8 +153,8 @@ Rigid3 RefineProjective(const ProxyModel& model, const PinholeIntrinsics& intrin
   for (size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3f& p = points[i];
     if (!(p.z() > 0)) continue;
-    const double x = in.fx * p.x() / p.z() + in.cx + 0.5;
-    const double y = in.fy * p.y() / p.z() + in.cy + 0.5;
+    const Eigen::Vector2d pixel = in.Project(p.cast<double>());
+    const double x = pixel.x() + 0.5, y = pixel.y() + 0.5;
     if (!(x >= 0 && y >= 0 && x < in.width && y < in.height)) continue;
     const int u = static_cast<int>(x), v = static_cast<int>(y);
     pixels[i] = {u, v};

@@ -768,7 +768,8 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
     // background and the checks keep the closest-point fit they were tuned on (refining that too
     // lost 0.3-0.6 points of frames within 5 deg and 1 cm on four Soldier takes and made a
     // 20-frame failure: docs/tracker.md).
-    Rigid3 camera_T_reported = chosen->icp.proxy_T_camera.Inverse();
+    const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
+    Rigid3 camera_T_reported = camera_T_proxy;
     if (options_.projective.iterations > 0) {
       camera_T_reported =
           RefineProjective(*model_, *intrinsics_, data_, scored_,
@@ -776,7 +777,6 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
                            options_.projective, sample_matches_)
               .Inverse();
     }
-    const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
     if (last_ && !result.detected && !slid) {
       velocity_ = camera_T_proxy * last_->Inverse();
     } else {
