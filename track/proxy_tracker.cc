@@ -84,6 +84,7 @@ void ProxyTrackerOptions::Validate(const std::string& prefix) const {
   model.Validate(prefix + ".model");
   icp.Validate(prefix + ".icp");
   projective.Validate(prefix + ".projective");
+  motion.Validate(prefix + ".motion");
   detection.Validate(prefix + ".detection");
   verification.Validate(prefix + ".verification");
 }
@@ -116,6 +117,7 @@ ProxyTracker::ProxyTracker(const TriangleMesh& model, const std::string& model_n
   options_.Validate("tracker");
   setup_.Validate("setup");
   model_ = std::make_unique<ProxyModel>(model, options_.model, model_name);
+  motion_.emplace(options_.motion, model_->centroid().cast<double>(), model_->radius());
   search_icp_ = options_.icp;
   search_icp_.prior_rotation_deg = 0;
   search_icp_.prior_translation = 0;
@@ -151,8 +153,7 @@ TrackFrameResult ProxyTracker::Unreadable(const RgbdFrame& frame, const std::str
   result.index = frame.index;
   result.timestamp = frame.timestamp;
   result.reason = "unreadable frame: " + error;
-  last_.reset();
-  velocity_.reset();
+  motion_->Reset();
   return result;
 }
 
@@ -402,9 +403,10 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   // a well-refined candidate near the prediction lets continuity decide (`better`).
   std::vector<Rigid3> seeds;
   if (predicted) seeds.push_back(*predicted);
-  if (last_ && (!predicted || !(last_->rotation.isApprox(predicted->rotation) &&
-                                last_->translation.isApprox(predicted->translation)))) {
-    seeds.push_back(*last_);
+  const std::optional<Rigid3>& last = motion_->last();
+  if (last && (!predicted || !(last->rotation.isApprox(predicted->rotation) &&
+                               last->translation.isApprox(predicted->translation)))) {
+    seeds.push_back(*last);
   }
   // ... and the prediction displaced: the tracked pose may sit in a nearby minimum the ICP cannot
   // leave (seen from the side under the hand, the figure slides along its vertical faces, or rolls
@@ -622,8 +624,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   auto lose = [&](const std::string& reason) {
     result.status = TrackStatus::kLost;
     result.reason = reason;
-    last_.reset();
-    velocity_.reset();
+    motion_->Reset();
     predicted_frames_ = 0;
     tracked_frames_ = 0;
     recent_score_.reset();
@@ -661,8 +662,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   intrinsics_ = k;
 
   // With a prediction, only the predicted proxy's image is examined.
-  std::optional<Rigid3> predicted;
-  if (last_) predicted = velocity_ ? *velocity_ * *last_ : *last_;
+  const std::optional<Rigid3> predicted = motion_->Predict();
   ImageRect window;
   if (predicted) window = ProxyImage(*predicted, options_.segmentation.window_margin);
   segmenter_.Segment(frame, &segmentation_, predicted ? &window : nullptr);
@@ -777,12 +777,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
                            options_.projective, sample_matches_)
               .Inverse();
     }
-    if (last_ && !result.detected && !slid) {
-      velocity_ = camera_T_proxy * last_->Inverse();
-    } else {
-      velocity_.reset();
-    }
-    last_ = camera_T_proxy;
+    motion_->Measure(camera_T_proxy, !result.detected && !slid);
     predicted_frames_ = 0;
     ++tracked_frames_;
     result.status = TrackStatus::kTracked;
@@ -797,15 +792,14 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   if (!enough) {
     why = "too few proxy points (" + std::to_string(result.points) + " < " +
           std::to_string(options_.verification.min_points) + ")";
-    if (last_ && predicted_frames_ < options_.verification.max_predicted_frames) {
+    if (motion_->last() && predicted_frames_ < options_.verification.max_predicted_frames) {
       // Extrapolate, slowing down: a hidden proxy is more likely to stop than to fly on.
-      if (velocity_) velocity_ = Interpolate(Rigid3::Identity(), *velocity_, 0.5);
-      last_ = velocity_ ? *velocity_ * *last_ : *last_;
+      const Rigid3 coasted = motion_->Coast();
       ++predicted_frames_;
       // Hidden, the proxy may be turned: continuity no longer tells it from its twins.
       tracked_frames_ = 0;
       result.status = TrackStatus::kPredicted;
-      result.camera_T_proxy = *last_;
+      result.camera_T_proxy = coasted;
       result.reason = why;
       return result;
     }

@@ -18,6 +18,7 @@
 #include "core/rgbd_frame.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
+#include "track/motion_model.h"
 #include "track/point_to_plane_icp.h"
 #include "track/projective_refinement.h"
 #include "track/proxy_model.h"
@@ -204,6 +205,7 @@ struct ProxyTrackerOptions {
   ProxyModelOptions model;
   IcpOptions icp = TrackingIcpOptions();
   ProjectiveOptions projective;
+  MotionOptions motion;
   DetectionOptions detection;
   VerificationOptions verification;
 
@@ -214,6 +216,7 @@ struct ProxyTrackerOptions {
     v("model", model);
     v("icp", icp);
     v("projective", projective);
+    v("motion", motion);
     v("detection", detection);
     v("verification", verification);
   }
@@ -318,9 +321,8 @@ class ProxyTracker {
   std::optional<PinholeIntrinsics> intrinsics_;
   std::optional<TablePlane> table_plane_;
   std::optional<Rigid3> camera_T_table_;
-  // Motion state: the last two measured poses and the frames predicted since.
-  std::optional<Rigid3> last_;
-  std::optional<Rigid3> velocity_;  // last * previous^-1 (camera frame, per frame)
+  // Motion state: the motion model (set in the constructor) and the frames predicted since.
+  std::optional<MotionModel> motion_;
   int predicted_frames_ = 0;
   int frames_since_detection_ = 0;
   int tracked_frames_ = 0;  // measured frames since the last loss
