@@ -95,7 +95,7 @@ struct DetectionOptions {
   // Slide check, on tracked frames: the tracked pose shifted by +-seed_shift along the table's
   // normal is refined (as the rival is) and replaces it when it scores switch_margin higher. Seen
   // from the side under the hand the Soldier's data hardly constrains its height, the
-  // constant-velocity prediction carries one frame's 5 mm of noise on, and the motion prior holds
+  // motion model's prediction carries one frame's 5 mm of noise on, and the motion prior holds
   // the pose there: it climbed 20 mm in three frames and stayed (or a check took its half-turn
   // twin, equally high); the displaced seeds of the periodic check came up to 15 frames late.
   bool slide_check = true;
