@@ -8,10 +8,10 @@
 
 #include <string>
 
-#include "sim/annotator.h"
-#include "sim/performance.h"
-#include "sim/population.h"
-#include "sim/viewer.h"
+#include "people/annotator.h"
+#include "people/performance.h"
+#include "people/population.h"
+#include "people/viewer.h"
 
 namespace {
 

@@ -1,5 +1,5 @@
 // The lag between a signal and a delayed copy of it, by cross-correlation: the annotator's reaction
-// delay (sim/annotator.h) and the lag of a read annotation (metrics/annotation_metrics.h).
+// delay (people/annotator.h) and the lag of a read annotation (metrics/annotation_metrics.h).
 #pragma once
 
 #include <span>

@@ -1,11 +1,11 @@
-#include "sim/annotator.h"
+#include "people/annotator.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
 #include "core/error.h"
-#include "sim/random.h"
+#include "people/random.h"
 
 namespace mmh::sim {
 namespace {

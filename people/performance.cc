@@ -1,4 +1,4 @@
-#include "sim/performance.h"
+#include "people/performance.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "core/error.h"
-#include "sim/random.h"
+#include "people/random.h"
 
 namespace mmh::sim {
 namespace {

@@ -1,7 +1,7 @@
-// Animators and their takes: a story (sim/story.h) acted out with a proxy at 30 fps, take after
+// Animators and their takes: a story (people/story.h) acted out with a proxy at 30 fps, take after
 // take. A take has its own timing (takes differ in length), the animator's style in every beat,
 // hand tremor and localised flaws; every frame carries the ground-truth pose and a latent quality
-// measured from the performance itself (sim/take_quality.h). The model is the harness's
+// measured from the performance itself (people/take_quality.h). The model is the harness's
 // hypothesis, documented in docs/people.md with every parameter.
 #pragma once
 
@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "core/trajectory.h"
-#include "sim/story.h"
-#include "sim/take_quality.h"
+#include "people/story.h"
+#include "people/take_quality.h"
 
 namespace mmh::sim {
 

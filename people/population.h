@@ -1,13 +1,13 @@
-// Simulated participants: each draws an animator (sim/performance.h) and an annotator
-// (sim/annotator.h) from the population's distributions. Deterministic in (seed, index), so that
+// Simulated participants: each draws an animator (people/performance.h) and an annotator
+// (people/annotator.h) from the population's distributions. Deterministic in (seed, index), so that
 // participant 7 is the same person whatever else is simulated.
 #pragma once
 
 #include <cstdint>
 #include <string>
 
-#include "sim/annotator.h"
-#include "sim/performance.h"
+#include "people/annotator.h"
+#include "people/performance.h"
 
 namespace mmh::sim {
 

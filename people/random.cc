@@ -1,4 +1,4 @@
-#include "sim/random.h"
+#include "people/random.h"
 
 #include <cmath>
 

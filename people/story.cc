@@ -1,4 +1,4 @@
-#include "sim/story.h"
+#include "people/story.h"
 
 #include <algorithm>
 #include <cmath>
@@ -94,7 +94,7 @@ BeatKind ParseKind(const nlohmann::json& value, const std::string& where) {
 }
 
 StoryObject ParseObject(const nlohmann::json& json, const std::string& where,
-                        const TableSceneOptions& scene) {
+                        const TableSetup& table) {
   if (!json.is_object()) ThrowBadValue(where, json.dump(), "an object");
   RequireKnownKeys(json, {"name", "proxy", "height", "path", "start", "end", "beats"}, where);
   StoryObject object;
@@ -111,8 +111,8 @@ StoryObject ParseObject(const nlohmann::json& json, const std::string& where,
     ThrowBadValue(where + ".path", path == json.end() ? "nothing" : path->dump(),
                   "a non-empty list of [x, y] waypoints in metres");
   }
-  const double half_width = 0.5 * scene.play_area_width;
-  const double half_depth = 0.5 * scene.play_area_depth;
+  const double half_width = 0.5 * table.play_area_width;
+  const double half_depth = 0.5 * table.play_area_depth;
   for (std::size_t k = 0; k < path->size(); ++k) {
     const nlohmann::json& p = (*path)[k];
     const std::string at = where + ".path[" + std::to_string(k) + "]";
@@ -308,7 +308,7 @@ int Story::ObjectIndex(const std::string& name) const {
   return -1;
 }
 
-Story ParseStory(const std::string& text, const std::string& file, const TableSceneOptions& scene) {
+Story ParseStory(const std::string& text, const std::string& file, const TableSetup& table) {
   nlohmann::json json;
   try {
     json = nlohmann::json::parse(text);
@@ -328,7 +328,7 @@ Story ParseStory(const std::string& text, const std::string& file, const TableSc
   }
   for (std::size_t k = 0; k < objects->size(); ++k) {
     const std::string where = file + ": objects[" + std::to_string(k) + "]";
-    StoryObject object = ParseObject((*objects)[k], where, scene);
+    StoryObject object = ParseObject((*objects)[k], where, table);
     if (story.ObjectIndex(object.name) >= 0) {
       ThrowBadValue(where + ".name", "\"" + object.name + "\"", "a name not used before");
     }
@@ -346,8 +346,8 @@ Story ParseStory(const std::string& text, const std::string& file, const TableSc
   return story;
 }
 
-Story LoadStory(const std::filesystem::path& file, const TableSceneOptions& scene) {
-  return ParseStory(ReadTextFile(file), file.string(), scene);
+Story LoadStory(const std::filesystem::path& file, const TableSetup& table) {
+  return ParseStory(ReadTextFile(file), file.string(), table);
 }
 
 double PolylineLength(std::span<const Eigen::Vector2d> points) {

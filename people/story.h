@@ -1,5 +1,5 @@
 // A story is data (configs/stories/*.json): for each object, the path it follows over the table
-// and the script's beats with their meaning and nominal timing. Animators (sim/performance.h)
+// and the script's beats with their meaning and nominal timing. Animators (people/performance.h)
 // act it out; the latent quality of a take is measured against it.
 //
 // File format (every key checked; unknown keys are errors):
@@ -37,7 +37,7 @@
 #include <utility>
 #include <vector>
 
-#include "sim/props.h"
+#include "core/table_setup.h"
 
 namespace mmh::sim {
 
@@ -62,7 +62,7 @@ const char* BeatKindName(BeatKind kind);
 bool Travels(BeatKind kind);
 
 // What the script asks of a beat: the motion's characteristic features, per unit intensity.
-// These are the targets a performance is judged against (sim/take_quality.h).
+// These are the targets a performance is judged against (people/take_quality.h).
 struct BeatStyleTarget {
   double step_rate = 0.0;  // [1/s] steps (or hops) per second; 0: none
   double bounce = 0.0;     // [m] height of a step's (or hop's) rise
@@ -114,12 +114,11 @@ struct Story {
 };
 
 // Reads and validates a story; every error names the file, the object and the beat, the value and
-// what was expected. Paths must lie inside the play area of `scene` (the table-top's defaults
-// unless given).
-Story LoadStory(const std::filesystem::path& file, const TableSceneOptions& scene = {});
+// what was expected. Paths must lie inside the play area of `table` (the default setup unless
+// given).
+Story LoadStory(const std::filesystem::path& file, const TableSetup& table = {});
 // The same from JSON text (`file` names it in messages).
-Story ParseStory(const std::string& text, const std::string& file,
-                 const TableSceneOptions& scene = {});
+Story ParseStory(const std::string& text, const std::string& file, const TableSetup& table = {});
 
 // Polyline helpers (points in order).
 double PolylineLength(std::span<const Eigen::Vector2d> points);

@@ -1,4 +1,4 @@
-#include "sim/take_quality.h"
+#include "people/take_quality.h"
 
 #include <algorithm>
 #include <cmath>

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "core/trajectory.h"
-#include "sim/story.h"
+#include "people/story.h"
 
 namespace mmh::sim {
 
@@ -34,7 +34,7 @@ struct QualityOptions {
   double window = 0.6;              // [s] half width of the feature window
   double path_sigma = 0.02;         // [m] σ_p
   double off_area_factor = 0.3;     // P's factor outside the play area
-  double play_area_width = 0.40;    // [m] as the scene's (TableSceneOptions)
+  double play_area_width = 0.40;    // [m] as the table's (core/table_setup.h)
   double play_area_depth = 0.30;    // [m]
   double steadiness_scale = 0.003;  // [m] r_0
   double steadiness_weight = 0.5;   // w_s

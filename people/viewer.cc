@@ -1,10 +1,10 @@
-#include "sim/viewer.h"
+#include "people/viewer.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
-#include "sim/random.h"
+#include "people/random.h"
 
 namespace mmh::sim {
 namespace {

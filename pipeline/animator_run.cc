@@ -14,8 +14,8 @@
 #include "pipeline/run_metrics.h"
 #include "sim/kinect_sensor.h"
 #include "sim/props.h"
-#include "sim/random.h"
-#include "sim/viewer.h"
+#include "people/random.h"
+#include "people/viewer.h"
 #include "track/frame_source.h"
 #include "track/setup.h"
 #include "track/track_session.h"
@@ -32,22 +32,6 @@ double SecondsSince(Clock::time_point start) {
 
 constexpr std::pair<Fidelity, const char*> kFidelityNames[] = {{Fidelity::kFull, "full"},
                                                                {Fidelity::kFast, "fast"}};
-
-// What the tracker is told about the setup, as a user calibrates it once before recording: the
-// camera's pose above the table (the tape marks), the play area and the Like box. `mmh render`
-// writes the same into scene.json.
-track::TrackSetup SetupOf(const sim::RenderConfig& config, const Rigid3& camera_T_table) {
-  track::TrackSetup setup;
-  setup.camera_T_table = camera_T_table;
-  setup.play_area_width = config.scene.play_area_width;
-  setup.play_area_depth = config.scene.play_area_depth;
-  setup.like_box_center_x = config.scene.like_box_center_x;
-  setup.like_box_center_y = config.scene.like_box_center_y;
-  setup.like_box_length = config.scene.like_box_length;
-  setup.like_box_width = config.scene.like_box_width;
-  setup.slider_block_size = sim::kSliderBlockSize;
-  return setup;
-}
 
 // One session to render and track: the proxy and slider per frame, and what the hand holds.
 struct SessionJob {
@@ -88,9 +72,11 @@ void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOption
   config.run.output_frame = track::OutputFrame::kTable;
   config.run.slider = job.annotation;
   config.run.proxy = !job.annotation;
-  job.run =
-      track::RunTracking(source, *job.model, job.model_name, SetupOf(render, job.camera_T_table),
-                         true, config, [&](int, int) { frame_done(); });
+  // What the tracker is told, as a user calibrates it once before recording (scene.json holds
+  // the same): the table's setup and the camera's pose above the table (the tape marks).
+  const track::TrackSetup setup{render.scene, job.camera_T_table};
+  job.run = track::RunTracking(source, *job.model, job.model_name, setup, true, config,
+                               [&](int, int) { frame_done(); });
   job.seconds = SecondsSince(start);
 }
 

@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "core/options.h"
-#include "sim/random.h"
+#include "people/random.h"
 
 namespace mmh::pipeline {
 namespace {

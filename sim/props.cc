@@ -194,15 +194,15 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   if (!std::isfinite(like_box_center_y)) {
     ThrowBadValue(prefix + ".like_box_center_y", FormatNumber(like_box_center_y), "a finite y [m]");
   }
-  if (like_box_length <= kSliderBlockSize) {
+  if (like_box_length <= slider_block_size) {
     ThrowBadValue(prefix + ".like_box_length", FormatNumber(like_box_length),
-                  "a length greater than the slider block (" + FormatNumber(kSliderBlockSize) +
+                  "a length greater than the slider block (" + FormatNumber(slider_block_size) +
                       " m) so that the block can slide");
   }
-  if (like_box_width < kSliderBlockSize) {
+  if (like_box_width < slider_block_size) {
     ThrowBadValue(
         prefix + ".like_box_width", FormatNumber(like_box_width),
-        "a width of at least the slider block (" + FormatNumber(kSliderBlockSize) + " m)");
+        "a width of at least the slider block (" + FormatNumber(slider_block_size) + " m)");
   }
   const double half_w = 0.5 * table_width;
   const double half_d = 0.5 * table_depth;
@@ -306,15 +306,13 @@ Rigid3 LikeBoxSliderPose(const TableSceneOptions& options, double value) {
     ThrowBadValue("slider value", FormatNumber(value), "a value in [-5, 5]");
   }
   options.Validate("scene");
-  const double travel = 0.5 * (options.like_box_length - kSliderBlockSize);
   return Rigid3(Eigen::Quaterniond::Identity(),
-                {options.like_box_center_x + value / 5.0 * travel, options.like_box_center_y, 0.0});
+                {options.SliderCenterX(value), options.like_box_center_y, 0.0});
 }
 
 double SliderValueFromPosition(const TableSceneOptions& options,
                                const Eigen::Vector3d& table_p_block) {
-  const double travel = 0.5 * (options.like_box_length - kSliderBlockSize);
-  return 5.0 * (table_p_block.x() - options.like_box_center_x) / travel;
+  return options.SliderValue(table_p_block.x());
 }
 
 void HandOptions::Validate(const std::string& prefix) const {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/rigid3.h"
+#include "core/table_setup.h"
 #include "core/triangle_mesh.h"
 
 namespace mmh::sim {
@@ -33,22 +34,16 @@ enum class TableProps {
 };
 std::span<const std::pair<TableProps, const char*>> EnumNames(TableProps);
 
-struct TableSceneOptions {
+// The table's calibration (core/table_setup.h: play area, Like box, slider block) and the furniture
+// around it. The slider block's size is not a config key: the scene's block is a 2x2 Duplo brick
+// (kSliderBlockSize).
+struct TableSceneOptions : TableSetup {
   // Table top [m]: width along x, depth along y, centred on the play area; its top at z = 0.
   double table_width = 1.2;
   double table_depth = 0.8;
   double table_thickness = 0.03;
   // Table top above the floor [m] (legs 5 cm square at the corners; the floor is at -height).
   double table_height = 0.75;
-  // Play area [m] centred at the origin, outlined by tape.
-  double play_area_width = 0.40;  // along x
-  double play_area_depth = 0.30;  // along y
-  // The Like box [m]: a taped rectangle right of the play area; the slider block slides along its
-  // long axis (x), -5 (dislike) at its left end, +5 (like) at its right end.
-  double like_box_center_x = 0.36;
-  double like_box_center_y = -0.05;
-  double like_box_length = 0.16;  // along x
-  double like_box_width = 0.06;   // along y
   // Tape [m]: laid outside the rectangles' edges (their insides keep their full size), 1 mm thick.
   double tape_width = 0.006;
   double tape_thickness = 0.001;
@@ -96,16 +91,16 @@ std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options);
 // The slider block: a green 2x2 Duplo brick, model frame as BuildDuploMesh (footprint centred, z =
 // 0 at its bottom), 31.8 mm square.
 TriangleMesh BuildSliderBlock();
-inline constexpr double kSliderBlockSize = 0.0318;  // [m]
+inline constexpr double kSliderBlockSize = TableSetup{}.slider_block_size;  // [m]
 
 // table_T_block for slider value `value` in [-5, 5]: the block stands on the table, centred across
-// the Like box, axis-aligned, its centre moving linearly along the box's long axis between the
-// positions where its edge touches the box's ends: x = center_x + value / 5 * (length - block) / 2.
-// A value outside [-5, 5] or NaN is an InputError.
+// the Like box, axis-aligned, its centre at TableSetup::SliderCenterX(value). A value outside
+// [-5, 5] or NaN is an InputError.
 Rigid3 LikeBoxSliderPose(const TableSceneOptions& options, double value);
 
-// The inverse: the slider value of a block whose centre is at table_p_block (only x counts). Not
-// clamped: a block pushed beyond the box's ends reads beyond +-5; clamp for an annotation.
+// The inverse (TableSetup::SliderValue): the slider value of a block whose centre is at
+// table_p_block (only x counts). Not clamped: a block pushed beyond the box's ends reads beyond
+// +-5; clamp for an annotation.
 double SliderValueFromPosition(const TableSceneOptions& options,
                                const Eigen::Vector3d& table_p_block);
 

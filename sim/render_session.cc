@@ -20,8 +20,8 @@
 #include "sim/bop_writer.h"
 #include "sim/duplo.h"
 #include "sim/fakenect_writer.h"
-#include "sim/random.h"
-#include "sim/story.h"
+#include "people/random.h"
+#include "people/story.h"
 
 namespace mmh::sim {
 namespace {
@@ -494,7 +494,7 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
                                    {camera_T_table.rotation.x(), camera_T_table.rotation.y(),
                                     camera_T_table.rotation.z(), camera_T_table.rotation.w()}}};
   scene_json["table"] = mmh::ToJson(config.scene);
-  scene_json["slider_block_size"] = kSliderBlockSize;
+  scene_json["slider_block_size"] = config.scene.slider_block_size;
   scene_json["groundtruth"] = "groundtruth.txt: camera_T_proxy of the depth camera";
   writer.Finish(groundtruth, {{"scene", scene_json}});
   WritePly(proxy_model, out / "model.ply");

@@ -21,9 +21,9 @@
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 #include "sim/kinect_sensor.h"
-#include "sim/population.h"
+#include "people/population.h"
 #include "sim/props.h"
-#include "sim/story.h"
+#include "people/story.h"
 
 namespace mmh::sim {
 

@@ -1,4 +1,4 @@
-#include "study/binomial_test.h"
+#include "stats/binomial_test.h"
 
 #include <algorithm>
 #include <boost/math/distributions/binomial.hpp>
@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "core/options.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 namespace bm = boost::math;
@@ -134,4 +134,4 @@ BinomialTestResult BinomialTest(std::int64_t successes, std::int64_t trials,
   return r;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 
 struct BinomialTestOptions {
   // Probability of success under the null hypothesis (R's p), in [0, 1].
@@ -45,4 +45,4 @@ struct BinomialTestResult {
 BinomialTestResult BinomialTest(std::int64_t successes, std::int64_t trials,
                                 const BinomialTestOptions& options = {});
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -1,4 +1,4 @@
-#include "study/chi_squared_test.h"
+#include "stats/chi_squared_test.h"
 
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "core/error.h"
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 double UpperTail(double statistic, double df) {
@@ -167,4 +167,4 @@ ChiSquaredResult ChiSquaredIndependence(const Eigen::MatrixXd& table, bool corre
   return r;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace mmh::study {
+namespace mmh::stats {
 
 struct ChiSquaredResult {
   std::string method;      // as R's method string
@@ -44,4 +44,4 @@ ChiSquaredResult ChiSquaredGoodnessOfFit(std::span<const double> observed,
 // row or column sums to zero (R returns NaN there).
 ChiSquaredResult ChiSquaredIndependence(const Eigen::MatrixXd& table, bool correct = true);
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -1,11 +1,11 @@
-#include "study/descriptive.h"
+#include "stats/descriptive.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
 
-namespace mmh::study {
+namespace mmh::stats {
 
 double Mean(std::span<const double> x) {
   if (x.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -50,4 +50,4 @@ std::vector<double> AverageRanks(std::span<const double> x) {
   return ranks;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-namespace mmh::study {
+namespace mmh::stats {
 
 // Arithmetic mean; NaN for an empty sample.
 double Mean(std::span<const double> x);
@@ -18,4 +18,4 @@ double Variance(std::span<const double> x);
 // equality, as in R.
 std::vector<double> AverageRanks(std::span<const double> x);
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -1,14 +1,14 @@
-#include "study/friedman_test.h"
+#include "stats/friedman_test.h"
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <map>
 
 #include "core/error.h"
-#include "study/descriptive.h"
-#include "study/htest.h"
+#include "stats/descriptive.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 
 nlohmann::json FriedmanResult::ToJson() const {
   return {{"test", "Friedman rank sum test"},
@@ -71,4 +71,4 @@ FriedmanResult FriedmanTest(const Eigen::MatrixXd& y) {
   return r;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-namespace mmh::study {
+namespace mmh::stats {
 
 struct FriedmanResult {
   std::size_t blocks = 0;  // n (R: rows of y), e.g. animators
@@ -32,4 +32,4 @@ struct FriedmanResult {
 // groups, or when every block is all ties (R returns NaN there: the statistic is 0 / 0).
 FriedmanResult FriedmanTest(const Eigen::MatrixXd& y);
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

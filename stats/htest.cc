@@ -1,11 +1,11 @@
-#include "study/htest.h"
+#include "stats/htest.h"
 
 #include <array>
 #include <cmath>
 
 #include "core/error.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 
 std::span<const std::pair<Alternative, const char*>> EnumNames(Alternative) {
   static constexpr std::array<std::pair<Alternative, const char*>, 3> kNames{{
@@ -39,4 +39,4 @@ void RequireConfidenceLevel(double level, const std::string& where) {
   }
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -8,7 +8,7 @@
 #include <string>
 #include <utility>
 
-namespace mmh::study {
+namespace mmh::stats {
 
 // Direction of the alternative hypothesis, named as in R (`alternative = "two.sided"`, ...).
 enum class Alternative { kTwoSided, kLess, kGreater };
@@ -35,4 +35,4 @@ void RequireAllFinite(std::span<const double> values, const std::string& where);
 // and 1").
 void RequireConfidenceLevel(double level, const std::string& where);
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

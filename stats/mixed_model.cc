@@ -1,4 +1,4 @@
-#include "study/mixed_model.h"
+#include "stats/mixed_model.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -12,9 +12,9 @@
 #include <numbers>
 
 #include "core/error.h"
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 namespace bm = boost::math;
@@ -571,4 +571,4 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
   return r;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

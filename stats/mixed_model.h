@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 
 struct MixedModelOptions {
   // Eigenvalues of the deviance Hessian below this are treated as zero when it is inverted
@@ -128,4 +128,4 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
                                          std::span<const double> y,
                                          const MixedModelOptions& options = {});
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

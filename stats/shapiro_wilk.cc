@@ -1,4 +1,4 @@
-#include "study/shapiro_wilk.h"
+#include "stats/shapiro_wilk.h"
 
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>
@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "core/error.h"
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 namespace bm = boost::math;
@@ -159,4 +159,4 @@ ShapiroWilkResult ShapiroWilkTest(std::span<const double> sample) {
   return r;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <span>
 
-namespace mmh::study {
+namespace mmh::stats {
 
 struct ShapiroWilkResult {
   std::size_t n = 0;
@@ -23,4 +23,4 @@ struct ShapiroWilkResult {
 // their range first.
 ShapiroWilkResult ShapiroWilkTest(std::span<const double> x);
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

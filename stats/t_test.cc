@@ -1,4 +1,4 @@
-#include "study/t_test.h"
+#include "stats/t_test.h"
 
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
@@ -6,9 +6,9 @@
 
 #include "core/error.h"
 #include "core/options.h"
-#include "study/descriptive.h"
+#include "stats/descriptive.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 
 void TTestOptions::Validate(const std::string& prefix) const {
   RequireFinite(mu, prefix + ".mu");
@@ -85,4 +85,4 @@ TTestResult OneSampleTTest(std::span<const double> x, const TTestOptions& option
   return r;
 }
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

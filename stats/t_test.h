@@ -7,9 +7,9 @@
 #include <span>
 #include <string>
 
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 
 struct TTestOptions {
   // Mean under the null hypothesis (R's mu), in the unit of the data.
@@ -48,4 +48,4 @@ struct TTestResult {
 // essentially constant"): the statistic is undefined there.
 TTestResult OneSampleTTest(std::span<const double> x, const TTestOptions& options = {});
 
-}  // namespace mmh::study
+}  // namespace mmh::stats

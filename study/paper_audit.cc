@@ -12,7 +12,7 @@
 
 #include "core/error.h"
 #include "core/text_parsing.h"
-#include "study/binomial_test.h"
+#include "stats/binomial_test.h"
 
 namespace mmh::study {
 namespace {
@@ -307,12 +307,12 @@ void ProportionTest(const Entry& e, AuditCheck* c) {
       const double x2 = (k - e1) * (k - e1) / e1 + (n - k - e2) * (n - k - e2) / e2;
       pv = bm::cdf(bm::complement(bm::chi_squared_distribution<double>(1.0), x2));
     } else {
-      BinomialTestOptions options;
+      stats::BinomialTestOptions options;
       options.p = chance;
-      options.alternative = tails == 2                             ? Alternative::kTwoSided
-                            : static_cast<double>(k) / n >= chance ? Alternative::kGreater
-                                                                   : Alternative::kLess;
-      pv = BinomialTest(k, n, options).p_value;
+      options.alternative = tails == 2                             ? stats::Alternative::kTwoSided
+                            : static_cast<double>(k) / n >= chance ? stats::Alternative::kGreater
+                                                                   : stats::Alternative::kLess;
+      pv = stats::BinomialTest(k, n, options).p_value;
     }
     p_min = std::min(p_min, pv);
     p_max = std::max(p_max, pv);

@@ -5,7 +5,7 @@
 #include <numeric>
 
 #include "core/error.h"
-#include "sim/random.h"
+#include "people/random.h"
 
 namespace mmh::study {
 namespace {

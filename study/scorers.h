@@ -1,5 +1,5 @@
 // Phase 2 of the paper's user study ("Comparing animations"), simulated: who compares what, and
-// what the simulated viewers (sim/viewer.h) prefer.
+// what the simulated viewers (people/viewer.h) prefer.
 //
 // Design (paper, "Task Design" and "Participants"): S scorers, the first N of them the animators;
 // each scorer compares the montage against one take for each of a set of animators
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/viewer.h"
+#include "people/viewer.h"
 #include "study/study_data.h"
 
 namespace mmh::study {

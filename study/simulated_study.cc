@@ -10,8 +10,8 @@
 
 #include "core/error.h"
 #include "core/options.h"
-#include "sim/random.h"
-#include "study/binomial_test.h"
+#include "people/random.h"
+#include "stats/binomial_test.h"
 
 namespace mmh::study {
 namespace {
@@ -220,9 +220,9 @@ std::vector<PowerEstimate> EstimatePower(const std::vector<StudyAnalysis>& analy
       if (*value < alpha) ++p.significant;
     }
     if (p.replicates > 0) {
-      BinomialTestOptions options;
+      stats::BinomialTestOptions options;
       options.conf_level = conf_level;
-      const auto ci = BinomialTest(p.significant, p.replicates, options);
+      const auto ci = stats::BinomialTest(p.significant, p.replicates, options);
       p.power = ci.estimate;
       p.conf_low = ci.conf_int.lower;
       p.conf_high = ci.conf_int.upper;

@@ -7,7 +7,7 @@
 //            compositor makes from the tracked takes and the read annotations.
 //   Phase 2  S scorers (the N animators among them) compare montages against takes
 //            (study/scorers.h); each animator ranks their own takes and montage. Every judgement
-//            is a simulated viewer's (sim/viewer.h) on what was recorded: the tracked
+//            is a simulated viewer's (people/viewer.h) on what was recorded: the tracked
 //            trajectories with their latent quality.
 //   Analysis study::AnalyzeStudy on the resulting StudyData: Friedman, H1-H3, segment costs.
 //
@@ -26,7 +26,7 @@
 #include "montage/compose.h"
 #include "pipeline/animator_run.h"
 #include "pipeline/error_model.h"
-#include "sim/viewer.h"
+#include "people/viewer.h"
 #include "study/scorers.h"
 #include "study/study_analysis.h"
 #include "study/study_data.h"

@@ -10,7 +10,7 @@
 
 #include "core/error.h"
 #include "core/options.h"
-#include "study/descriptive.h"
+#include "stats/descriptive.h"
 
 namespace mmh::study {
 namespace {
@@ -39,7 +39,7 @@ std::string Short(double value) {
   return buffer;
 }
 
-std::string Interval(const ConfidenceInterval& ci) {
+std::string Interval(const stats::ConfidenceInterval& ci) {
   // An infinite end is open: [0.6, Inf).
   return Short(100.0 * ci.level) + "% CI " + (std::isinf(ci.lower) ? "(" : "[") + Short(ci.lower) +
          ", " + Short(ci.upper) + (std::isinf(ci.upper) ? ")" : "]");
@@ -64,7 +64,8 @@ std::string TestRowCsv(const TestRow& r) {
 }
 
 // Sets the p-value, the estimate and its interval of `row`.
-TestRow& SetEstimate(TestRow& row, double p_value, double estimate, const ConfidenceInterval& ci) {
+TestRow& SetEstimate(TestRow& row, double p_value, double estimate,
+                     const stats::ConfidenceInterval& ci) {
   row.p_value = p_value;
   row.estimate = estimate;
   row.conf_low = ci.lower;
@@ -73,7 +74,7 @@ TestRow& SetEstimate(TestRow& row, double p_value, double estimate, const Confid
   return row;
 }
 
-TestRow TRow(const std::string& analysis, const TTestResult& t) {
+TestRow TRow(const std::string& analysis, const stats::TTestResult& t) {
   TestRow row{.analysis = analysis,
               .test = "one-sample t-test",
               .statistic_name = "t",
@@ -86,7 +87,7 @@ TestRow TRow(const std::string& analysis, const TTestResult& t) {
   return row;
 }
 
-TestRow FriedmanRow(const FriedmanResult& f) {
+TestRow FriedmanRow(const stats::FriedmanResult& f) {
   TestRow row{.analysis = "rankings",
               .test = "Friedman rank sum test",
               .statistic_name = "chi-squared",
@@ -99,7 +100,7 @@ TestRow FriedmanRow(const FriedmanResult& f) {
   return row;
 }
 
-TestRow BinomialRow(const std::string& analysis, const BinomialTestResult& b) {
+TestRow BinomialRow(const std::string& analysis, const stats::BinomialTestResult& b) {
   TestRow row{.analysis = analysis,
               .test = "exact binomial test",
               .statistic_name = "successes",
@@ -111,7 +112,7 @@ TestRow BinomialRow(const std::string& analysis, const BinomialTestResult& b) {
   return row;
 }
 
-TestRow ChiRow(const std::string& analysis, const ChiSquaredResult& c) {
+TestRow ChiRow(const std::string& analysis, const stats::ChiSquaredResult& c) {
   TestRow row{.analysis = analysis,
               .test = c.method,
               .statistic_name = "X-squared",
@@ -124,7 +125,7 @@ TestRow ChiRow(const std::string& analysis, const ChiSquaredResult& c) {
   return row;
 }
 
-TestRow ShapiroRow(const std::string& analysis, const ShapiroWilkResult& s) {
+TestRow ShapiroRow(const std::string& analysis, const stats::ShapiroWilkResult& s) {
   TestRow row{.analysis = analysis,
               .test = "Shapiro-Wilk normality test",
               .statistic_name = "W",
@@ -134,7 +135,8 @@ TestRow ShapiroRow(const std::string& analysis, const ShapiroWilkResult& s) {
   return row;
 }
 
-TestRow FRow(const std::string& analysis, const std::string& test, const FTest& f, double n) {
+TestRow FRow(const std::string& analysis, const std::string& test, const stats::FTest& f,
+             double n) {
   TestRow row{.analysis = analysis,
               .test = test,
               .statistic_name = "F",
@@ -159,7 +161,7 @@ std::span<const std::pair<H1Unit, const char*>> EnumNames(H1Unit) {
 }
 
 void StudyAnalysisOptions::Validate(const std::string& prefix) const {
-  RequireConfidenceLevel(conf_level, prefix + ".conf_level");
+  stats::RequireConfidenceLevel(conf_level, prefix + ".conf_level");
   if (!(chance > 0.0 && chance < 1.0)) {
     ThrowBadValue(prefix + ".chance", FormatNumber(chance), "a probability in (0, 1)");
   }
@@ -219,8 +221,8 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
       for (const auto& item : a.rankings.items) y(i, j++) = by_item.at(item);
       ++i;
     }
-    a.rankings.friedman =
-        Attempt<FriedmanResult>("Friedman test", &summary, [&] { return FriedmanTest(y); });
+    a.rankings.friedman = Attempt<stats::FriedmanResult>("Friedman test", &summary,
+                                                         [&] { return stats::FriedmanTest(y); });
   }
 
   // ---- m_ij ----
@@ -262,28 +264,28 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
     } else {
       std::map<std::string, std::vector<double>> per_animator;
       for (const auto& s : a.take_scores) per_animator[s.animator].push_back(s.m);
-      for (const auto& [animator, ms] : per_animator) sample.push_back(Mean(ms));
+      for (const auto& [animator, ms] : per_animator) sample.push_back(stats::Mean(ms));
     }
-    a.h1.mean_m = Mean(sample);
-    a.h1.sd_m = sample.size() > 1 ? std::sqrt(Variance(sample)) : NAN;
-    TTestOptions t;
+    a.h1.mean_m = stats::Mean(sample);
+    a.h1.sd_m = sample.size() > 1 ? std::sqrt(stats::Variance(sample)) : NAN;
+    stats::TTestOptions t;
     t.mu = options.chance;
     t.alternative = options.alternative;
     t.conf_level = options.conf_level;
-    a.h1.t_test =
-        Attempt<TTestResult>("H1 t-test", &summary, [&] { return OneSampleTTest(sample, t); });
+    a.h1.t_test = Attempt<stats::TTestResult>("H1 t-test", &summary,
+                                              [&] { return stats::OneSampleTTest(sample, t); });
     const std::vector<double> counts = {static_cast<double>(a.h1.wins),
                                         static_cast<double>(a.h1.comparisons - a.h1.wins)};
     const std::vector<double> p = {options.chance, 1.0 - options.chance};
-    a.h1.chi_squared = Attempt<ChiSquaredResult>(
-        "H1 chi-squared test", &summary, [&] { return ChiSquaredGoodnessOfFit(counts, p); });
-    BinomialTestOptions b;
+    a.h1.chi_squared = Attempt<stats::ChiSquaredResult>(
+        "H1 chi-squared test", &summary, [&] { return stats::ChiSquaredGoodnessOfFit(counts, p); });
+    stats::BinomialTestOptions b;
     b.p = options.chance;
     b.alternative = options.alternative;
     b.conf_level = options.conf_level;
-    a.h1.binomial = Attempt<BinomialTestResult>("H1 binomial test", &summary, [&] {
-      return BinomialTest(static_cast<std::int64_t>(a.h1.wins),
-                          static_cast<std::int64_t>(a.h1.comparisons), b);
+    a.h1.binomial = Attempt<stats::BinomialTestResult>("H1 binomial test", &summary, [&] {
+      return stats::BinomialTest(static_cast<std::int64_t>(a.h1.wins),
+                                 static_cast<std::int64_t>(a.h1.comparisons), b);
     });
   }
 
@@ -308,13 +310,14 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
                                  " animators without comparisons of all " + std::to_string(k) +
                                  " takes");
     }
-    a.h2.normality = Attempt<ShapiroWilkResult>("H2 Shapiro-Wilk test", &summary,
-                                                [&] { return ShapiroWilkTest(b); });
-    TTestOptions t;
+    a.h2.normality = Attempt<stats::ShapiroWilkResult>("H2 Shapiro-Wilk test", &summary,
+                                                       [&] { return stats::ShapiroWilkTest(b); });
+    stats::TTestOptions t;
     t.mu = options.all_takes_chance;
     t.alternative = options.alternative;
     t.conf_level = options.conf_level;
-    a.h2.t_test = Attempt<TTestResult>("H2 t-test", &summary, [&] { return OneSampleTTest(b, t); });
+    a.h2.t_test = Attempt<stats::TTestResult>("H2 t-test", &summary,
+                                              [&] { return stats::OneSampleTTest(b, t); });
   }
 
   // ---- H3: m_ij ~ take + (1 | animator) ----
@@ -334,27 +337,27 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
       by_take[s.take - 1].push_back(s.m);
     }
     for (const auto& ms : by_take) {
-      a.h3.take_means.push_back(Mean(ms));
+      a.h3.take_means.push_back(stats::Mean(ms));
       a.h3.take_standard_errors.push_back(
-          ms.size() > 1 ? std::sqrt(Variance(ms) / static_cast<double>(ms.size())) : NAN);
+          ms.size() > 1 ? std::sqrt(stats::Variance(ms) / static_cast<double>(ms.size())) : NAN);
     }
-    a.h3.mixed_model = Attempt<MixedModelResult>("H3 mixed model", &summary, [&] {
-      return FitRandomInterceptModel(group, level, y, options.mixed_model);
+    a.h3.mixed_model = Attempt<stats::MixedModelResult>("H3 mixed model", &summary, [&] {
+      return stats::FitRandomInterceptModel(group, level, y, options.mixed_model);
     });
     if (a.h3.mixed_model.result) {
       for (const auto& w : a.h3.mixed_model.result->summary.warnings) {
         summary.warnings.push_back("H3 mixed model: " + w);
       }
-      a.h3.residual_normality = Attempt<ShapiroWilkResult>(
+      a.h3.residual_normality = Attempt<stats::ShapiroWilkResult>(
           "H3 residual Shapiro-Wilk test", &summary,
-          [&] { return ShapiroWilkTest(a.h3.mixed_model.result->residuals); });
+          [&] { return stats::ShapiroWilkTest(a.h3.mixed_model.result->residuals); });
     } else {
       a.h3.residual_normality.not_computed = "no mixed model";
     }
     Eigen::MatrixXd table = Eigen::MatrixXd::Zero(k, 2);
     for (const auto& c : data.comparisons) table(c.take - 1, c.montage_preferred ? 0 : 1) += 1.0;
-    a.h3.take_table = Attempt<ChiSquaredResult>("H3 take x preference table", &summary, [&] {
-      return ChiSquaredIndependence(table, options.yates);
+    a.h3.take_table = Attempt<stats::ChiSquaredResult>("H3 take x preference table", &summary, [&] {
+      return stats::ChiSquaredIndependence(table, options.yates);
     });
   }
 
@@ -396,15 +399,15 @@ nlohmann::json StudyAnalysis::ToJson() const {
   rank_json["items"] = rankings.items;
   rank_json["friedman"] = rankings.friedman.ToJson();
   j["rankings"] = rank_json;
-  j["h1"] = {{"unit", EnumName(options.h1_unit)},      {"mean_m", FiniteOrNull(h1.mean_m)},
-             {"sd_m", FiniteOrNull(h1.sd_m)},          {"montage_preferred", h1.wins},
+  j["h1"] = {{"unit", EnumName(options.h1_unit)},      {"mean_m", stats::FiniteOrNull(h1.mean_m)},
+             {"sd_m", stats::FiniteOrNull(h1.sd_m)},   {"montage_preferred", h1.wins},
              {"comparisons", h1.comparisons},          {"t_test", h1.t_test.ToJson()},
              {"chi_squared", h1.chi_squared.ToJson()}, {"binomial", h1.binomial.ToJson()}};
   nlohmann::json b = nlohmann::json::array();
   for (const auto& [animator, value] : h2.b) b.push_back({{"animator", animator}, {"b", value}});
   j["h2"] = {{"b", b}, {"normality", h2.normality.ToJson()}, {"t_test", h2.t_test.ToJson()}};
   nlohmann::json se = nlohmann::json::array();
-  for (double v : h3.take_standard_errors) se.push_back(FiniteOrNull(v));
+  for (double v : h3.take_standard_errors) se.push_back(stats::FiniteOrNull(v));
   j["h3"] = {{"take_means", h3.take_means},
              {"take_standard_errors", se},
              {"mixed_model", h3.mixed_model.ToJson()},
@@ -431,7 +434,7 @@ std::string StudyAnalysis::TestsCsv() const {
     if (m->rm_anova) out += TestRowCsv(FRow("h3", "repeated-measures ANOVA F", *m->rm_anova, n));
     // The take differences (fixed effects after the intercept): take j minus take 1.
     for (std::size_t j = 1; j < m->fixed_effects.size(); ++j) {
-      const FixedEffect& e = m->fixed_effects[j];
+      const stats::FixedEffect& e = m->fixed_effects[j];
       TestRow row{.analysis = "h3",
                   .test = "mixed model t (Satterthwaite) " + e.name + " - take1",
                   .statistic_name = "t",
@@ -450,7 +453,7 @@ std::string StudyAnalysis::TestsCsv() const {
 
 std::string StudyAnalysis::TakeScoresCsv() const {
   std::string out = "animator,take,comparisons,montage_preferred,m,fitted,residual\n";
-  const MixedModelResult* model = h3.mixed_model.result ? &*h3.mixed_model.result : nullptr;
+  const stats::MixedModelResult* model = h3.mixed_model.result ? &*h3.mixed_model.result : nullptr;
   for (std::size_t i = 0; i < take_scores.size(); ++i) {
     const TakeScore& s = take_scores[i];
     out += s.animator + "," + std::to_string(s.take) + "," + std::to_string(s.comparisons) + "," +
@@ -482,7 +485,7 @@ std::string StudyAnalysis::Report() const {
   std::ostringstream out;
   const auto p = [](double v) { return "p = " + Short(v); };
   const std::string tail =
-      options.alternative == Alternative::kTwoSided ? "two-tailed" : "one-tailed";
+      options.alternative == stats::Alternative::kTwoSided ? "two-tailed" : "one-tailed";
   out << "data: " << summary.animators << " animators, " << summary.scorers << " scorers, "
       << summary.comparisons << " comparisons of " << summary.takes << " takes; "
       << summary.ranking_animators << " animators ranked " << rankings.items.size() << " items\n";
@@ -522,7 +525,7 @@ std::string StudyAnalysis::Report() const {
     out << "H2: t-test not computed (" << h2.t_test.not_computed << ")\n";
   }
   if (const auto& m = h3.mixed_model.result) {
-    const FTest& f = m->take_test;
+    const stats::FTest& f = m->take_test;
     out << "H3: mixed model F(" << Short(f.num_df) << ", " << Short(f.den_df)
         << ") = " << Short(f.f) << ", " << p(f.p_value) << " (animator variance "
         << Short(m->group_variance) << ", residual " << Short(m->residual_variance)

@@ -25,13 +25,13 @@
 #include <utility>
 #include <vector>
 
-#include "study/binomial_test.h"
-#include "study/chi_squared_test.h"
-#include "study/friedman_test.h"
-#include "study/mixed_model.h"
-#include "study/shapiro_wilk.h"
+#include "stats/binomial_test.h"
+#include "stats/chi_squared_test.h"
+#include "stats/friedman_test.h"
+#include "stats/mixed_model.h"
+#include "stats/shapiro_wilk.h"
+#include "stats/t_test.h"
 #include "study/study_data.h"
-#include "study/t_test.h"
 
 namespace mmh::study {
 
@@ -44,7 +44,7 @@ struct StudyAnalysisOptions {
   // Coverage of every confidence interval.
   double conf_level = 0.95;
   // Alternative of H1's and H2's tests (paper: one-tailed, montage better than chance).
-  Alternative alternative = Alternative::kGreater;
+  stats::Alternative alternative = stats::Alternative::kGreater;
   // Probability that the montage wins a comparison by chance (paper: 0.5).
   double chance = 0.5;
   // Probability that the montage beats all takes by chance, H2's null mean of b_i (paper: 0.125 =
@@ -58,7 +58,7 @@ struct StudyAnalysisOptions {
   // "less than 1% in all the 10 cases").
   double cost_increase_threshold_percent = 1.0;
   StudyDataOptions data;
-  MixedModelOptions mixed_model;
+  stats::MixedModelOptions mixed_model;
 
   template <class V>
   void VisitFields(V& v) {
@@ -109,7 +109,7 @@ struct StudySummary {
 
 struct RankingAnalysis {
   std::vector<std::string> items;  // column order of the Friedman test (sorted names)
-  Outcome<FriedmanResult> friedman;
+  Outcome<stats::FriedmanResult> friedman;
 };
 
 struct H1Analysis {
@@ -117,22 +117,23 @@ struct H1Analysis {
   double sd_m = 0.0;     // its standard deviation
   std::size_t wins = 0;  // comparisons the montage won
   std::size_t comparisons = 0;
-  Outcome<TTestResult> t_test;
-  Outcome<ChiSquaredResult> chi_squared;
-  Outcome<BinomialTestResult> binomial;
+  Outcome<stats::TTestResult> t_test;
+  Outcome<stats::ChiSquaredResult> chi_squared;
+  Outcome<stats::BinomialTestResult> binomial;
 };
 
 struct H2Analysis {
   std::vector<std::pair<std::string, double>> b;  // (animator, b_i), animators with every take
-  Outcome<ShapiroWilkResult> normality;
-  Outcome<TTestResult> t_test;
+  Outcome<stats::ShapiroWilkResult> normality;
+  Outcome<stats::TTestResult> t_test;
 };
 
 struct H3Analysis {
-  Outcome<MixedModelResult> mixed_model;
-  Outcome<ShapiroWilkResult> residual_normality;
-  Outcome<ChiSquaredResult> take_table;  // K x 2: per take, montage preferred / take preferred
-  std::vector<double> take_means;        // mean m_ij per take (Figure 11)
+  Outcome<stats::MixedModelResult> mixed_model;
+  Outcome<stats::ShapiroWilkResult> residual_normality;
+  Outcome<stats::ChiSquaredResult>
+      take_table;                  // K x 2: per take, montage preferred / take preferred
+  std::vector<double> take_means;  // mean m_ij per take (Figure 11)
   std::vector<double> take_standard_errors;
 };
 

@@ -9,7 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/text_parsing.h"
-#include "study/descriptive.h"
+#include "stats/descriptive.h"
 
 namespace mmh::study {
 namespace {
@@ -277,7 +277,7 @@ void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
     }
     bool valid = true;
     if (options.allow_tied_ranks) {
-      valid = AverageRanks(ranks) == ranks;
+      valid = stats::AverageRanks(ranks) == ranks;
     } else {
       std::vector<double> sorted = ranks;
       std::sort(sorted.begin(), sorted.end());

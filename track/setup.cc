@@ -40,19 +40,7 @@ Eigen::VectorXd Numbers(const nlohmann::json& object, const std::string& key, in
 }  // namespace
 
 void TrackSetup::Validate(const std::string& where) const {
-  RequirePositive(play_area_width, where + ".play_area_width", "m");
-  RequirePositive(play_area_depth, where + ".play_area_depth", "m");
-  RequireFinite(like_box_center_x, where + ".like_box_center_x");
-  RequireFinite(like_box_center_y, where + ".like_box_center_y");
-  RequireNonNegative(like_box_length, where + ".like_box_length", "m");
-  RequirePositive(slider_block_size, where + ".slider_block_size", "m");
-  if (has_like_box()) {
-    RequirePositive(like_box_width, where + ".like_box_width", "m");
-    if (!(like_box_length > slider_block_size)) {
-      ThrowBadValue(where + ".like_box_length", FormatNumber(like_box_length),
-                    "more than slider_block_size = " + FormatNumber(slider_block_size) + " m");
-    }
-  }
+  TableSetup::Validate(where);
   if (camera_T_table) {
     RequireFinite(camera_T_table->translation.norm(), where + ".camera_T_table.translation");
     if (std::abs(camera_T_table->rotation.norm() - 1) > 1e-6) {

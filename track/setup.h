@@ -13,29 +13,20 @@
 #include <string>
 
 #include "core/rigid3.h"
+#include "core/table_setup.h"
 
 namespace mmh::track {
 
-struct TrackSetup {
+// The table's calibration (play area, Like box, slider block; core/table_setup.h) and, optionally,
+// where the camera stands.
+struct TrackSetup : TableSetup {
   // Pose of the table frame (z up, origin at the play area's centre on the table top, x right as
   // the camera sees it) in the depth camera's frame; nullopt: the tracker derives it from the
   // estimated plane (origin where the optical axis meets it, x along the camera's x).
   std::optional<Rigid3> camera_T_table;
-  // The taped play area, centred on the table frame's origin [m].
-  double play_area_width = 0.40;  // along x
-  double play_area_depth = 0.30;  // along y
-  // The Like box [m]: centre in the table frame, length along x (-5 at its -x end, +5 at its +x
-  // end), width along y. Without a Like box (like_box_length = 0) the slider is not read.
-  double like_box_center_x = 0.36;
-  double like_box_center_y = -0.05;
-  double like_box_length = 0.16;
-  double like_box_width = 0.06;
-  // Edge length of the (square) green slider block [m]; its centre travels between the positions
-  // where it touches the box's ends.
-  double slider_block_size = 0.0318;
 
-  bool has_like_box() const { return like_box_length > 0; }
-  // Positive finite sizes, a block shorter than the box; InputError naming `where`.
+  // TableSetup::Validate and a finite camera_T_table with a unit quaternion; InputError naming
+  // `where`.
   void Validate(const std::string& where) const;
 };
 

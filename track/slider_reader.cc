@@ -132,8 +132,7 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
     if (hidden_low > rows / 2 && hidden_low >= 2 * hidden_high) reading.center_x = hi - 0.5 * size;
     if (hidden_high > rows / 2 && hidden_high >= 2 * hidden_low) reading.center_x = lo + 0.5 * size;
   }
-  const double travel = (setup_.like_box_length - setup_.slider_block_size) / 2;
-  reading.raw_value = 5.0 * (reading.center_x - setup_.like_box_center_x) / travel;
+  reading.raw_value = setup_.SliderValue(reading.center_x);
   reading.value = std::clamp(reading.raw_value, -5.0, 5.0);
   reading.found = true;
   return reading;

@@ -1,6 +1,6 @@
 // The annotator: the delay recovered by cross-correlation is the configured one, the hand is
 // smooth and speed-limited, lapses hold the block, and the judgement follows the quality.
-#include "sim/annotator.h"
+#include "people/annotator.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/error.h"
-#include "sim/performance.h"
+#include "people/performance.h"
 #include "tests/test_util.h"
 
 namespace mmh::sim {

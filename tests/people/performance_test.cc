@@ -1,6 +1,6 @@
 // Performances: deterministic, on the story's path, better with skill and over takes, flaws where
 // their beats are, and a latent quality that is measured from the motion.
-#include "sim/performance.h"
+#include "people/performance.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // The population: reproducible participants inside the documented ranges.
-#include "sim/population.h"
+#include "people/population.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Stories: the shipped ones load, and every kind of bad story gives an error that names the file
 // and the beat.
-#include "sim/story.h"
+#include "people/story.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The viewer model: smooth motion has no artefacts, a jump does, blending hides it, and viewers
 // prefer the better animation.
-#include "sim/viewer.h"
+#include "people/viewer.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
-#include "study/binomial_test.h"
+#include "stats/binomial_test.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 using golden::Golden;
@@ -51,4 +51,4 @@ TEST(BinomialTest, RejectsBadInput) {
 }
 
 }  // namespace
-}  // namespace mmh::study
+}  // namespace mmh::stats

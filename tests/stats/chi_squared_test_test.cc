@@ -1,11 +1,11 @@
-#include "study/chi_squared_test.h"
+#include "stats/chi_squared_test.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 using golden::Golden;
@@ -95,4 +95,4 @@ TEST(ChiSquared, RejectsBadInput) {
 }
 
 }  // namespace
-}  // namespace mmh::study
+}  // namespace mmh::stats

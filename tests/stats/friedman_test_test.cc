@@ -1,11 +1,11 @@
-#include "study/friedman_test.h"
+#include "stats/friedman_test.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 using golden::Golden;
@@ -57,4 +57,4 @@ TEST(FriedmanTest, RejectsBadShapesAndValues) {
 }
 
 }  // namespace
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "core/options.h"
-#include "study/htest.h"
+#include "stats/htest.h"
 
-namespace mmh::study::golden {
+namespace mmh::stats::golden {
 
 // The matching tolerance of the issue: 1e-10 relative.
 inline constexpr double kRelative = 1e-10;
@@ -77,6 +77,6 @@ inline Alternative AlternativeNamed(const std::string& name) {
 }
 
 #define MMH_EXPECT_NEAR_R(actual, expected, ...) \
-  EXPECT_TRUE(::mmh::study::golden::Near((actual), (expected)__VA_OPT__(, ) __VA_ARGS__)) << #actual
+  EXPECT_TRUE(::mmh::stats::golden::Near((actual), (expected)__VA_OPT__(, ) __VA_ARGS__)) << #actual
 
-}  // namespace mmh::study::golden
+}  // namespace mmh::stats::golden

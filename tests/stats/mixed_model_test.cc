@@ -1,12 +1,12 @@
-#include "study/mixed_model.h"
+#include "stats/mixed_model.h"
 
 #include <gtest/gtest.h>
 
-#include "study/shapiro_wilk.h"
-#include "tests/study/golden.h"
+#include "stats/shapiro_wilk.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 using golden::Golden;
@@ -186,4 +186,4 @@ TEST(RandomInterceptModel, RejectsDegenerateData) {
 }
 
 }  // namespace
-}  // namespace mmh::study
+}  // namespace mmh::stats

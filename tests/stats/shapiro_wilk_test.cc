@@ -1,11 +1,11 @@
-#include "study/shapiro_wilk.h"
+#include "stats/shapiro_wilk.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 using golden::Golden;
@@ -45,4 +45,4 @@ TEST(ShapiroWilkTest, RejectsSampleSizesOutsideAlgorithmRange) {
 }
 
 }  // namespace
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -1,13 +1,13 @@
-#include "study/t_test.h"
+#include "stats/t_test.h"
 
 #include <gtest/gtest.h>
 
 #include "core/error.h"
 #include "core/options.h"
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
-namespace mmh::study {
+namespace mmh::stats {
 namespace {
 
 using golden::Golden;
@@ -76,4 +76,4 @@ TEST(OneSampleTTest, OptionsFromJsonRejectUnknownAlternative) {
 }
 
 }  // namespace
-}  // namespace mmh::study
+}  // namespace mmh::stats

@@ -4,7 +4,7 @@
 
 #include <cstdlib>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
 namespace mmh::study {
@@ -13,7 +13,7 @@ namespace {
 // Same shape; numbers equal to 1e-9 relative (another BLAS may round lme4's algebra differently).
 void ExpectSameJson(const nlohmann::json& a, const nlohmann::json& b, const std::string& path) {
   if (a.is_number() && b.is_number()) {
-    EXPECT_TRUE(golden::Near(a.get<double>(), b.get<double>(), 1e-9)) << path;
+    EXPECT_TRUE(stats::golden::Near(a.get<double>(), b.get<double>(), 1e-9)) << path;
     return;
   }
   ASSERT_EQ(a.type(), b.type()) << path;
@@ -46,7 +46,8 @@ TEST(GoldenValues, MakeGoldenRReproducesTheCommittedFile) {
   const std::string command = "Rscript '" + script + "' '" + (dir / "golden.json").string() +
                               "' >'" + (dir / "log").string() + "' 2>&1";
   ASSERT_EQ(std::system(command.c_str()), 0) << test_util::ReadBytes(dir / "log");
-  ExpectSameJson(golden::ReadJsonFile(dir / "golden.json"), golden::Golden(), "golden");
+  ExpectSameJson(stats::golden::ReadJsonFile(dir / "golden.json"), stats::golden::Golden(),
+                 "golden");
 }
 
 }  // namespace

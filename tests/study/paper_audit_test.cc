@@ -4,7 +4,7 @@
 
 #include <set>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
 namespace mmh::study {

@@ -6,13 +6,13 @@
 #include <fstream>
 #include <random>
 
-#include "tests/study/golden.h"
+#include "tests/stats/golden.h"
 #include "tests/test_util.h"
 
 namespace mmh::study {
 namespace {
 
-using golden::Near;
+using stats::golden::Near;
 using test_util::TempDir;
 
 const std::filesystem::path kExample =
@@ -20,12 +20,12 @@ const std::filesystem::path kExample =
 const std::filesystem::path kAnalyzeScript =
     std::filesystem::path(MMH_TEST_DATA_DIR) / "study" / "analyze_study.R";
 
-void ExpectHtest(const TTestResult& t, const nlohmann::json& r) {
+void ExpectHtest(const stats::TTestResult& t, const nlohmann::json& r) {
   MMH_EXPECT_NEAR_R(t.t, r.at("statistic").get<double>());
   MMH_EXPECT_NEAR_R(t.df, r.at("parameter").get<double>());
   MMH_EXPECT_NEAR_R(t.p_value, r.at("p_value").get<double>());
-  MMH_EXPECT_NEAR_R(t.conf_int.lower, golden::Number(r.at("conf_int")[0], -1.0));
-  MMH_EXPECT_NEAR_R(t.conf_int.upper, golden::Number(r.at("conf_int")[1], 1.0));
+  MMH_EXPECT_NEAR_R(t.conf_int.lower, stats::golden::Number(r.at("conf_int")[0], -1.0));
+  MMH_EXPECT_NEAR_R(t.conf_int.upper, stats::golden::Number(r.at("conf_int")[1], 1.0));
 }
 
 // Every number of AnalyzeStudy against R's analysis of the same CSV files (analyze_study.R).
@@ -51,7 +51,7 @@ void ExpectMatchesR(const StudyAnalysis& a, const nlohmann::json& r) {
                     h1.at("binomial").at("conf_int")[0].get<double>());
 
   const auto& h2 = r.at("h2");
-  const std::vector<double> b = golden::Vector(h2.at("b"));
+  const std::vector<double> b = stats::golden::Vector(h2.at("b"));
   ASSERT_EQ(a.h2.b.size(), b.size());
   for (std::size_t i = 0; i < b.size(); ++i) MMH_EXPECT_NEAR_R(a.h2.b[i].second, b[i]);
   ASSERT_TRUE(a.h2.normality.result && a.h2.t_test.result);
@@ -61,7 +61,7 @@ void ExpectMatchesR(const StudyAnalysis& a, const nlohmann::json& r) {
 
   const auto& h3 = r.at("h3");
   ASSERT_TRUE(a.h3.mixed_model.result);
-  const MixedModelResult& m = *a.h3.mixed_model.result;
+  const stats::MixedModelResult& m = *a.h3.mixed_model.result;
   EXPECT_EQ(m.boundary, h3.at("singular").get<bool>());
   MMH_EXPECT_NEAR_R(m.sigma, h3.at("sigma").get<double>());
   MMH_EXPECT_NEAR_R(m.take_test.f, h3.at("anova").at("f").get<double>());
@@ -85,8 +85,8 @@ void ExpectMatchesR(const StudyAnalysis& a, const nlohmann::json& r) {
 
 TEST(AnalyzeStudy, ExampleMatchesRsAnalysisOfTheSameCsvFiles) {
   const StudyAnalysis a = AnalyzeStudy(ReadStudyData(kExample));
-  ExpectMatchesR(a, golden::ReadJsonFile(std::filesystem::path(MMH_TEST_DATA_DIR) / "study" /
-                                         "example_expected.json"));
+  ExpectMatchesR(a, stats::golden::ReadJsonFile(std::filesystem::path(MMH_TEST_DATA_DIR) / "study" /
+                                                "example_expected.json"));
   ASSERT_TRUE(a.segment_constraint);
   EXPECT_EQ(a.segment_constraint->animators_with_short_segments, 10u);
   EXPECT_TRUE(a.segment_constraint->all_below_threshold);
@@ -133,7 +133,7 @@ TEST(AnalyzeStudy, LiveRCheckOnRandomUnbalancedStudies) {
     ASSERT_EQ(std::system(command.c_str()), 0) << test_util::ReadBytes(dir / "r.log");
     const StudyAnalysis a = AnalyzeStudy(ReadStudyData(dir.path()));
     EXPECT_FALSE(a.h3.mixed_model.result->summary.balanced);
-    ExpectMatchesR(a, golden::ReadJsonFile(dir / "r.json"));
+    ExpectMatchesR(a, stats::golden::ReadJsonFile(dir / "r.json"));
   }
 }
 

@@ -16,10 +16,10 @@
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
 #include "sim/kinect_sensor.h"
-#include "sim/performance.h"
-#include "sim/population.h"
+#include "people/performance.h"
+#include "people/population.h"
 #include "sim/render_session.h"
-#include "sim/story.h"
+#include "people/story.h"
 #include "track/setup.h"
 
 namespace mmh::track::test_take {
@@ -52,18 +52,7 @@ class SimTake {
   }
 
   // The setup calibration a user would mark once (as scene.json holds it).
-  TrackSetup Setup() const {
-    TrackSetup setup;
-    setup.camera_T_table = depth_T_table_;
-    setup.play_area_width = config_.scene.play_area_width;
-    setup.play_area_depth = config_.scene.play_area_depth;
-    setup.like_box_center_x = config_.scene.like_box_center_x;
-    setup.like_box_center_y = config_.scene.like_box_center_y;
-    setup.like_box_length = config_.scene.like_box_length;
-    setup.like_box_width = config_.scene.like_box_width;
-    setup.slider_block_size = sim::kSliderBlockSize;
-    return setup;
-  }
+  TrackSetup Setup() const { return TrackSetup{config_.scene, depth_T_table_}; }
 
   const TriangleMesh& model() const { return model_; }
   const Rigid3& depth_T_table() const { return depth_T_table_; }
