@@ -1,7 +1,5 @@
 #include "cli/compose_command.h"
 
-#include <tbb/global_control.h>
-
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
@@ -27,23 +25,6 @@ struct ComposeArgs {
   std::vector<std::string> annotations;
   std::vector<int> markers;
 };
-
-}  // namespace
-
-Config LoadConfig(const CommonFlags& common) {
-  Config config;
-  if (!common.config_file.empty()) config = Config::Load(common.config_file);
-  for (const auto& set : common.sets) config.Set(set);
-  return config;
-}
-
-std::shared_ptr<void> LimitThreads(int threads) {
-  if (threads <= 0) return nullptr;
-  return std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                               threads);
-}
-
-namespace {
 
 void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
   const Config config = LoadConfig(args.common);
@@ -140,16 +121,10 @@ void AddComposeCommand(CLI::App& app, const std::vector<std::string>& argv) {
                   "Annotation CSVs (timestamp,value), one per take, same order")
       ->required()
       ->expected(1, -1);
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
   cmd->add_option("--markers", args->markers,
                   "Spatial markers: montage frames (at least 60 apart); writes markers.tum")
       ->expected(1, -1);
-  cmd->add_option("--config", args->common.config_file, "JSON config with a 'montage' section");
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common, {.config_help = "JSON config with a 'montage' section"});
   cmd->callback([args, argv] { RunCompose(*args, argv); });
 }
 

@@ -1,7 +1,5 @@
 // `mmh regress`: runs the scenarios of a baseline (pipeline/regress.h) and compares every metric
 // with its tolerance; exit code 1 on a regression. `--update` writes a new baseline instead.
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
@@ -10,7 +8,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
-#include "cli/compose_command.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "cli/run_command.h"
 #include "core/atomic_file.h"
@@ -96,7 +94,7 @@ void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
   const auto threads = LimitThreads(args.common.threads);
   const std::filesystem::path out = args.common.out_dir;
   EnsureDirectory(out);
-  const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
+  const bool bar = ShowProgress(args.common);
   std::vector<pipeline::MetricComparison> comparisons;
   nlohmann::json updated = nlohmann::json::array();
   nlohmann::json report = nlohmann::json::array();
@@ -192,13 +190,10 @@ void AddRegressCommand(CLI::App& app, const std::vector<std::string>& argv) {
   CLI::App* cmd = app.add_subcommand(
       "regress", "Run a baseline's scenarios and compare every metric with its tolerance");
   cmd->add_option("--baseline", args->baseline, "Baseline folder (with baseline.json)")->required();
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
   cmd->add_option("--scenario", args->scenarios, "Run only these scenarios (repeatable)");
   cmd->add_flag("--update", args->update,
                 "Write the runs' metrics into the baseline (keeping its tolerances)");
-  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common, {.config_help = "", .set = false});
   cmd->callback([args, argv] { RunRegress(*args, argv); });
 }
 

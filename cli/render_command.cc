@@ -1,14 +1,12 @@
 #include "cli/render_command.h"
 
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "cli/command_registry.h"
-#include "cli/compose_command.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
@@ -24,7 +22,7 @@ void RunRender(const CommonFlags& common, const std::vector<std::string>& argv) 
   const Config config = LoadConfig(common);
   const sim::RenderConfig render = sim::RenderConfig::FromConfig(config);
   const auto threads = LimitThreads(common.threads);
-  const bool bar = !common.quiet && isatty(STDERR_FILENO);
+  const bool bar = ShowProgress(common);
   const std::filesystem::path out = common.out_dir;
   const sim::RenderSummary summary = sim::RenderSequence(render, out, [&](int done, int total) {
     if (bar && (done % 10 == 0 || done == total)) {
@@ -126,14 +124,10 @@ void AddRenderCommand(CLI::App& app, const std::vector<std::string>& argv) {
   auto common = std::make_shared<CommonFlags>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Synthetic Kinect v1 RGB-D sequence (TUM RGB-D folder, fakenect dump, BOP)");
-  cmd->add_option("--config", common->config_file,
-                  "JSON config: sections render, camera, scene, hand, sensor, motion");
-  cmd->add_option("--set", common->sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_option("--out", common->out_dir, "Output folder (a TUM RGB-D folder)")->required();
-  cmd->add_option("--threads", common->threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--quiet", common->quiet, "Print nothing on success");
+  AddCommonFlags(
+      cmd, common.get(),
+      {.config_help = "JSON config: sections render, camera, scene, hand, sensor, motion",
+       .out_help = "Output folder (a TUM RGB-D folder)"});
   cmd->callback([common, argv] { RunRender(*common, argv); });
 }
 
@@ -150,11 +144,11 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
       ->capture_default_str();
   cmd->add_option("--frames", args->frames, "Rendered frames to analyse")
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--config", args->common.config_file, "Render config for the rendered frames");
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value, repeatable")->take_all();
-  cmd->add_option("--out", args->common.out_dir, "Write sensor_check.json here");
-  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "Render config for the rendered frames",
+                  .out_help = "Write sensor_check.json here",
+                  .out_required = false,
+                  .quiet = false});
   cmd->callback([args, argv] { RunSensorCheck(*args, argv); });
 }
 

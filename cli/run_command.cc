@@ -1,8 +1,6 @@
 // `mmh run`: one animator end to end (pipeline/animator_run.h), its files (pipeline/run_output.h).
 #include "cli/run_command.h"
 
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
@@ -12,7 +10,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
-#include "cli/compose_command.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
@@ -31,34 +29,6 @@ struct RunArgs {
   long long seed = -1;
   bool resume = false;
 };
-
-// A progress bar on a terminal (stderr), nothing otherwise.
-class ProgressBar {
- public:
-  ProgressBar(bool enabled, std::string label) : enabled_(enabled), label_(std::move(label)) {}
-  void Update(std::int64_t done, std::int64_t total) {
-    if (!enabled_ || total <= 0) return;
-    const int width = 30;
-    const int filled = static_cast<int>(width * done / total);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    std::fprintf(stderr, "\r%s [%s%s] %lld / %lld frames, %.0f frames/s ", label_.c_str(),
-                 std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-                 static_cast<long long>(done), static_cast<long long>(total),
-                 seconds > 0 ? done / seconds : 0.0);
-    if (done == total) std::fprintf(stderr, "\n");
-    std::fflush(stderr);
-  }
-
- private:
-  bool enabled_;
-  std::string label_;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
-};
-
-}  // namespace
-
-namespace {
 
 // --resume continues a run whose sessions were made with the same config: only the sections
 // that come after the sessions (montage, metrics, run.min_tracked_share) may change.
@@ -141,7 +111,7 @@ void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
   const pipeline::RunConfig run_config = pipeline::RunConfig::FromConfig(config);
   const auto threads = LimitThreads(args.common.threads);
   const std::filesystem::path out = args.common.out_dir;
-  const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
+  const bool bar = ShowProgress(args.common);
   const pipeline::AnimatorRun run = RunScenario(run_config, run_config.render.render.animator, out,
                                                 bar, argv, args.common.threads, args.resume);
   if (args.common.quiet) return;
@@ -188,23 +158,17 @@ void AddRunCommand(CLI::App& app, const std::vector<std::string>& argv) {
   auto args = std::make_shared<RunArgs>();
   CLI::App* cmd = app.add_subcommand(
       "run", "One animator end to end: performance -> sensor -> tracker -> montage -> metrics");
-  cmd->add_option("--config", args->common.config_file,
-                  "JSON config (e.g. configs/soldier.json): render sections, tracker, slider, "
-                  "montage, metrics, error_model, run")
-      ->required();
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "JSON config (e.g. configs/soldier.json): render sections, "
+                                 "tracker, slider, montage, metrics, error_model, run",
+                  .config_required = true});
   cmd->add_option("--animator", args->animator, "Participant index (sets render.animator)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", args->seed, "Population seed (sets population.seed)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--resume", args->resume,
                 "Reuse the takes an earlier run in --out finished (same config but for montage, "
                 "metrics); run the rest");
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
   cmd->callback([args, argv] { RunRun(*args, argv); });
 }
 

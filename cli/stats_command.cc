@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
-#include "cli/compose_command.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
@@ -76,11 +76,8 @@ void AddStatsCommand(CLI::App& app, const std::vector<std::string>& argv) {
                   "Study folder: rankings.csv, comparisons.csv, segment_costs.csv (optional); "
                   "docs/statistics.md")
       ->required();
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
-  cmd->add_option("--config", args->common.config_file, "JSON config with a 'stats' section");
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "JSON config with a 'stats' section", .threads = false});
   cmd->callback([args, argv] { RunStats(*args, argv); });
 }
 

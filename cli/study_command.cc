@@ -2,7 +2,6 @@
 // (study/simulated_study.h), its statistics, Figures 8-11, the side-by-side table with the paper,
 // and with --replicates the power of each test. docs/study.md describes every output.
 #include <tbb/global_control.h>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -12,7 +11,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
-#include "cli/compose_command.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
@@ -96,7 +95,7 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
 
   // Everything is computed before anything is written: bad input or a failed run leaves no output.
   const int replicates = study_config.study.replicates;
-  const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
+  const bool bar = ShowProgress(args.common);
   std::optional<study::SimulatedStudy> first;
   std::vector<study::StudyAnalysis> analyses;
   std::string replicates_csv = study::ReplicatesCsvHeader();
@@ -248,20 +247,14 @@ void AddStudyCommand(CLI::App& app, const std::vector<std::string>& argv) {
   auto args = std::make_shared<StudyArgs>();
   CLI::App* cmd = app.add_subcommand(
       "study", "The paper's user study on simulated animators and scorers through the pipeline");
-  cmd->add_option("--config", args->common.config_file,
-                  "JSON config (configs/study_soldier.json): the run sections and study, scorers, "
-                  "viewer");
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "JSON config (configs/study_soldier.json): the run sections and "
+                                 "study, scorers, viewer"});
   cmd->add_option("--replicates", args->replicates,
                   "Independent studies (power of each test); overrides study.replicates")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--paper-reported", args->paper_reported,
                   "The paper's reported numbers (default: configs/paper_reported.json)");
-  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
   cmd->callback([args, argv] { RunStudy(*args, argv); });
 }
 

@@ -2,7 +2,6 @@
 // libfreenect); writes trajectory.tum, status.csv, annotation.csv, track_summary.json,
 // config.resolved.json and run.json (docs/tracker.md).
 #include <tbb/global_control.h>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
@@ -11,7 +10,7 @@
 #include <stdexcept>
 
 #include "cli/command_registry.h"
-#include "cli/compose_command.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
@@ -75,7 +74,7 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                         : std::nullopt);
   }
 
-  const bool bar = !args.common.quiet && isatty(STDERR_FILENO);
+  const bool bar = ShowProgress(args.common);
   const track::TrackRun run = track::RunTracking(*source, model, args.model, setup, calibrated,
                                                  track_config, [&](int done, int total) {
                                                    if (bar && done % 10 == 0) {
@@ -151,14 +150,8 @@ void AddTrackCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->add_option("--setup", args->setup,
                   "Setup calibration (scene.json keys: camera_T_table, table.play_area_*, "
                   "table.like_box_*); default: INPUT/scene.json when present");
-  cmd->add_option("--config", args->common.config_file,
-                  "JSON config: sections run, tracker, slider, freenect");
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
-  cmd->add_option("--threads", args->common.threads, "Worker threads (0: all cores)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "JSON config: sections run, tracker, slider, freenect"});
   cmd->callback([args, argv] { RunTrack(*args, argv); });
 }
 

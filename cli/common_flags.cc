@@ -1,0 +1,65 @@
+#include "cli/common_flags.h"
+
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "core/config.h"
+
+namespace mmh::cli {
+
+void AddCommonFlags(CLI::App* command, CommonFlags* flags, const CommonFlagsSpec& spec) {
+  if (!spec.config_help.empty()) {
+    CLI::Option* config = command->add_option("--config", flags->config_file, spec.config_help);
+    if (spec.config_required) config->required();
+  }
+  if (spec.set) {
+    command->add_option("--set", flags->sets, "Override: key.path=value (JSON value), repeatable")
+        ->take_all();
+  }
+  if (!spec.out_help.empty()) {
+    CLI::Option* out = command->add_option("--out", flags->out_dir, spec.out_help);
+    if (spec.out_required) out->required();
+  }
+  if (spec.threads) {
+    command->add_option("--threads", flags->threads, "Worker threads (0: all cores)")
+        ->check(CLI::NonNegativeNumber);
+  }
+  if (spec.quiet) command->add_flag("--quiet", flags->quiet, "Print nothing on success");
+}
+
+Config LoadConfig(const CommonFlags& common) {
+  Config config;
+  if (!common.config_file.empty()) config = Config::Load(common.config_file);
+  for (const auto& set : common.sets) config.Set(set);
+  return config;
+}
+
+std::shared_ptr<void> LimitThreads(int threads) {
+  if (threads <= 0) return nullptr;
+  return std::make_shared<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               threads);
+}
+
+bool ShowProgress(const CommonFlags& common) { return !common.quiet && isatty(STDERR_FILENO); }
+
+ProgressBar::ProgressBar(bool enabled, std::string label, std::string unit)
+    : enabled_(enabled), label_(std::move(label)), unit_(std::move(unit)) {}
+
+void ProgressBar::Update(std::int64_t done, std::int64_t total) {
+  if (!enabled_ || total <= 0) return;
+  const int width = 30;
+  const int filled = static_cast<int>(width * done / total);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::fprintf(stderr, "\r%s [%s%s] %lld / %lld %s, %.0f %s/s ", label_.c_str(),
+               std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
+               static_cast<long long>(done), static_cast<long long>(total), unit_.c_str(),
+               seconds > 0 ? done / seconds : 0.0, unit_.c_str());
+  if (done == total) std::fprintf(stderr, "\n");
+  std::fflush(stderr);
+}
+
+}  // namespace mmh::cli

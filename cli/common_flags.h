@@ -1,0 +1,66 @@
+// The flags every subcommand shares (DESIGN.md, "Command line"): --config, --set, --out,
+// --threads, --quiet, registered in one place with one meaning, and what every command does with
+// them: load the config with the overrides, limit the worker threads, show progress on a terminal.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace mmh {
+class Config;
+}
+
+namespace mmh::cli {
+
+struct CommonFlags {
+  std::string config_file;
+  std::vector<std::string> sets;
+  std::string out_dir;
+  int threads = 0;
+  bool quiet = false;
+};
+
+// Which of the common flags a subcommand has, and the words of its help that differ.
+struct CommonFlagsSpec {
+  std::string config_help = "JSON config";  // empty: no --config
+  bool config_required = false;
+  bool set = true;                         // --set key.path=value, repeatable
+  std::string out_help = "Output folder";  // empty: no --out
+  bool out_required = true;
+  bool threads = true;
+  bool quiet = true;
+};
+
+// Adds the flags `spec` asks for to `command`, storing into `flags` (which must outlive parsing).
+void AddCommonFlags(CLI::App* command, CommonFlags* flags, const CommonFlagsSpec& spec = {});
+
+// The config file (if any) with the --set overrides applied.
+Config LoadConfig(const CommonFlags& common);
+
+// Limits oneTBB to `threads` worker threads while the returned handle lives (0: no limit).
+std::shared_ptr<void> LimitThreads(int threads);
+
+// Whether progress should be drawn: stderr is a terminal and --quiet is not given.
+bool ShowProgress(const CommonFlags& common);
+
+// A progress bar on stderr (done / total, rate), or nothing when disabled.
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, std::string label, std::string unit = "frames");
+  void Update(std::int64_t done, std::int64_t total);
+
+ private:
+  bool enabled_;
+  std::string label_;
+  std::string unit_;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace mmh::cli
