@@ -56,51 +56,87 @@ Case RandomCase(std::mt19937_64& rng, int min_run, int max_run) {
   return c;
 }
 
-// Each maximal run [first, last] of take l becomes source frames [w_l(first), w_l(last)],
-// concatenated.
-std::vector<MontageSegment> MyUnwarp(const std::vector<int>& labels,
-                                     const std::vector<std::vector<int>>& warps) {
-  std::vector<MontageSegment> out;
-  int montage = 0;
-  for (const auto& r : oracle::Runs(labels)) {
-    MontageSegment s;
-    s.take = r.label;
-    s.reference_first = r.first;
-    s.reference_last = r.last;
-    s.source_first = warps[r.label][r.first];
-    s.source_last = warps[r.label][r.last];
-    s.montage_first = montage;
-    s.montage_last = montage + s.source_last - s.source_first;
-    montage = s.montage_last + 1;
-    out.push_back(s);
+// The unwarped montage played frame by frame, without Unwarp's per-segment formula: walking the
+// reference timeline, the first frame of a run of take l plays that take's source frame w_l(t);
+// each further step t - 1 -> t inside the run plays the source frames after w_l(t - 1) up to
+// w_l(t), each once, in order (the paper's "corresponding interval" of the original take, built
+// step by step). Returns the (take, source frame) of every montage frame, and the reference frame
+// each montage frame was played from.
+struct Played {
+  std::vector<std::pair<int, int>> frames;
+  std::vector<int> reference;
+};
+Played PlayUnwarped(const std::vector<int>& labels, const std::vector<std::vector<int>>& warps) {
+  Played played;
+  for (int t = 0; t < static_cast<int>(labels.size()); ++t) {
+    const int l = labels[t];
+    const int from = t > 0 && labels[t - 1] == l ? warps[l][t - 1] + 1 : warps[l][t];
+    for (int source = from; source <= warps[l][t]; ++source) {
+      played.frames.emplace_back(l, source);
+      played.reference.push_back(t);
+    }
   }
-  return out;
+  return played;
 }
 
-TEST(Blend, UnwarpMatchesDefinition) {
+TEST(Blend, UnwarpPlaysEveryRunsSourceFramesOnce) {
   std::mt19937_64 rng(31);
   for (int rep = 0; rep < 40; ++rep) {
+    SCOPED_TRACE("rep " + std::to_string(rep));
     const Case c = RandomCase(rng, 1, 50);
-    const auto got = Unwarp(c.labels, c.warps);
-    const auto want = MyUnwarp(c.labels, c.warps);
-    ASSERT_EQ(got.size(), want.size()) << "rep " << rep;
-    for (std::size_t i = 0; i < got.size(); ++i) {
-      SCOPED_TRACE("rep " + std::to_string(rep) + " segment " + std::to_string(i));
-      EXPECT_EQ(got[i].take, want[i].take);
-      EXPECT_EQ(got[i].reference_first, want[i].reference_first);
-      EXPECT_EQ(got[i].reference_last, want[i].reference_last);
-      EXPECT_EQ(got[i].source_first, want[i].source_first);
-      EXPECT_EQ(got[i].source_last, want[i].source_last);
-      EXPECT_EQ(got[i].montage_first, want[i].montage_first);
-      EXPECT_EQ(got[i].montage_last, want[i].montage_last);
+    const auto segments = Unwarp(c.labels, c.warps);
+    const Played want = PlayUnwarped(c.labels, c.warps);
+    // The segments' montage frames, expanded: contiguous from 0, each a take's source frame.
+    std::vector<std::pair<int, int>> got;
+    int next_montage = 0, next_reference = 0;
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+      const MontageSegment& s = segments[i];
+      SCOPED_TRACE("segment " + std::to_string(i));
+      ASSERT_EQ(s.montage_first, next_montage);
+      ASSERT_EQ(s.montage_last - s.montage_first, s.source_last - s.source_first);
+      for (int f = s.source_first; f <= s.source_last; ++f) got.emplace_back(s.take, f);
+      // The segment starts where its first montage frame was played from and covers exactly one
+      // run of equal labels (maximal: the neighbours' takes differ; the runs tile the timeline).
+      ASSERT_EQ(s.reference_first, next_reference);
+      ASSERT_LT(s.montage_first, static_cast<int>(want.reference.size()));
+      EXPECT_EQ(want.reference[s.montage_first], s.reference_first);
+      for (int t = s.reference_first; t <= s.reference_last; ++t) ASSERT_EQ(c.labels[t], s.take);
+      if (i > 0) EXPECT_NE(segments[i - 1].take, s.take);
+      next_montage = s.montage_last + 1;
+      next_reference = s.reference_last + 1;
     }
+    EXPECT_EQ(next_reference, static_cast<int>(c.labels.size()));
+    ASSERT_EQ(got, want.frames);
     if (HasFailure()) return;
   }
 }
 
+// A run of one reference frame plays one source frame; a flat stretch of a warp (several
+// reference frames on one source frame) plays it once.
+TEST(Blend, UnwarpByHand) {
+  // Take 0 is the reference (identity warp); take 1 runs at half speed, then holds.
+  const std::vector<std::vector<int>> warps = {{0, 1, 2, 3, 4, 5}, {0, 2, 4, 6, 6, 6}};
+  const auto segments = Unwarp({0, 1, 1, 0, 1, 1}, warps);
+  ASSERT_EQ(segments.size(), 4u);
+  auto expect = [&](int i, int take, int r0, int r1, int s0, int s1, int m0, int m1) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(segments[i].take, take);
+    EXPECT_EQ(segments[i].reference_first, r0);
+    EXPECT_EQ(segments[i].reference_last, r1);
+    EXPECT_EQ(segments[i].source_first, s0);
+    EXPECT_EQ(segments[i].source_last, s1);
+    EXPECT_EQ(segments[i].montage_first, m0);
+    EXPECT_EQ(segments[i].montage_last, m1);
+  };
+  expect(0, 0, 0, 0, 0, 0, 0, 0);
+  expect(1, 1, 1, 2, 2, 4, 1, 3);  // source 2, 3, 4 at the take's own speed
+  expect(2, 0, 3, 3, 3, 3, 4, 4);
+  expect(3, 1, 4, 5, 6, 6, 5, 5);  // the held frame once
+}
+
 void CheckBlend(const Case& c, const BlendOptions& options, const std::string& where) {
   SCOPED_TRACE(where);
-  const auto segs = MyUnwarp(c.labels, c.warps);
+  const auto segs = Unwarp(c.labels, c.warps);  // checked against PlayUnwarped above
   int narrowed = -1;
   const double start = 3.25, period = 1.0 / 30.0;
   const Trajectory montage = BlendMontage(c.takes, segs, options, start, period, &narrowed);
