@@ -58,7 +58,12 @@ export class View3d {
         this.scene.add(this.root);
         this.clip = gltf.animations.find((a) => a.name === 'montage') || gltf.animations[0];
         this.mixer = new THREE.AnimationMixer(this.root);
-        this.mixer.clipAction(this.clip).play();
+        // Played once and held at the end: a repeating action would wrap the last frame (at the
+        // clip's duration) back to the first.
+        const action = this.mixer.clipAction(this.clip);
+        action.setLoop(THREE.LoopOnce, 1);
+        action.clampWhenFinished = true;
+        action.play();
         const name = THREE.PropertyBinding.sanitizeNodeName(this.montage.node);
         this.node = this.root.getObjectByName(name);
         const track = this.clip.tracks.find((t) => t.name === `${name}.position`);
@@ -81,7 +86,7 @@ export class View3d {
     const grid = new THREE.GridHelper(size * 1.5, 20, 0xb0b0b0, 0xd8d8d8);
     grid.position.set(center.x, box.min.y, center.z);
     this.scene.add(grid);
-    this.camera.position.copy(center).add(new THREE.Vector3(0, size * 0.55, size * 0.9));
+    this.camera.position.copy(center).add(new THREE.Vector3(0, size * 0.4, size * 0.6));
     this.camera.near = size / 200;
     this.camera.far = size * 20;
     this.camera.updateProjectionMatrix();
@@ -133,9 +138,8 @@ export class View3d {
     const w = gl.drawingBufferWidth, h = gl.drawingBufferHeight;
     const pixels = new Uint8Array(4 * w * h);
     gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
-    const bg = new THREE.Color(kBackground);
-    // The drawing buffer holds sRGB-encoded output.
-    const ref = [bg.r, bg.g, bg.b].map((c) => Math.round(c * 255));
+    // The drawing buffer holds sRGB-encoded output: compare with the background's sRGB bytes.
+    const ref = [(kBackground >> 16) & 255, (kBackground >> 8) & 255, kBackground & 255];
     let count = 0;
     for (let i = 0; i < pixels.length; i += 4) {
       if (Math.abs(pixels[i] - ref[0]) + Math.abs(pixels[i + 1] - ref[1]) + Math.abs(pixels[i + 2] - ref[2]) > 24) ++count;
