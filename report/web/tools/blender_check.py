@@ -9,6 +9,12 @@ import sys
 
 import addon_utils
 import bpy
+import numpy
+
+# Debian 12's Blender 3.4 importer uses numpy.bool, an alias NumPy 1.24 (Debian 12's) removed
+# (gltf2_blender_mesh.py, set_poly_smoothing); it was always the builtin bool.
+if "bool" not in numpy.__dict__:
+    numpy.bool = bool
 
 args = sys.argv[sys.argv.index("--") + 1:]
 path, fps, frames = args[0], int(args[1]), [int(k) for k in args[2].split(",") if k]
