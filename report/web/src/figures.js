@@ -162,7 +162,15 @@ function tableElement(table) {
 
 export function tableSection(table) {
   const node = section(table.title, table.note);
-  node.append(tableElement({ ...table, title: table.file || '' }));
+  const content = tableElement({ ...table, title: table.file || '' });
+  if (table.rows.length <= 40) {
+    node.append(content);
+  } else {
+    // Long tables (a run's metrics.csv) start folded.
+    const details = element('details', {}, [element('summary', {}, [`${table.rows.length} rows`])]);
+    details.append(content);
+    node.append(details);
+  }
   return node;
 }
 

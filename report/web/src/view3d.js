@@ -86,7 +86,13 @@ export class View3d {
     const grid = new THREE.GridHelper(size * 1.5, 20, 0xb0b0b0, 0xd8d8d8);
     grid.position.set(center.x, box.min.y, center.z);
     this.scene.add(grid);
-    this.camera.position.copy(center).add(new THREE.Vector3(0, size * 0.4, size * 0.6));
+    // Far enough that the whole width (glTF x: the columns) fits the horizontal field of view.
+    const extent = box.getSize(new THREE.Vector3());
+    const vertical = THREE.MathUtils.degToRad(this.camera.fov);
+    const horizontal = 2 * Math.atan(Math.tan(vertical / 2) * this.camera.aspect);
+    const distance = 1.15 * Math.max(extent.x / 2 / Math.tan(horizontal / 2) + extent.z / 2,
+      extent.y / 2 / Math.tan(vertical / 2));
+    this.camera.position.copy(center).add(new THREE.Vector3(0, 0.5, 0.87).multiplyScalar(distance));
     this.camera.near = size / 200;
     this.camera.far = size * 20;
     this.camera.updateProjectionMatrix();
