@@ -121,10 +121,15 @@ void ValidateScene(const GltfScene& scene) {
     }
   }
   for (const GltfAnimation& animation : scene.animations) {
+    std::map<std::string, int> names;  // the extras' time origins are keyed by node name
     for (const GltfTrack& track : animation.tracks) {
       const std::string where = "glTF animation " + animation.name + " track of node " +
                                 std::to_string(track.node);
       if (track.node < 0 || track.node >= nodes) ThrowBadValue(where, "node index", "a node");
+      if (++names[scene.nodes[track.node].name] > 1) {
+        ThrowBadValue(where, "node name " + scene.nodes[track.node].name + " animated twice",
+                      "one track per node and unique names of animated nodes");
+      }
       ValidateTrajectory(track.parent_T_node, where);
       for (std::size_t i = 0; i < track.parent_T_node.size(); ++i) {
         CheckPose(track.parent_T_node.poses[i], where + " frame " + std::to_string(i));

@@ -206,6 +206,13 @@ TEST(ReportCli, BadFoldersExitTwoAndWriteNothing) {
   EXPECT_NE(r.output.find("expected the output of mmh compose"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "other" / "report.html"));
 
+  // compose with a model that cannot be read: nothing written.
+  WriteText(dir / "broken.obj", "v 0 0 nan\nf 1 2 3\n");
+  r = RunMmh(Compose(dir / "bad_model", "--model " + (dir / "broken.obj").string()));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("broken.obj"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad_model"));
+
   // A compose folder whose takes are gone.
   const auto out = dir / "compose";
   std::filesystem::create_directories(dir / "takes");
