@@ -149,15 +149,24 @@ std::string HtmlEscape(const std::string& text) {
   return out;
 }
 
-// A take's path as written in summary.json: as given (relative to where mmh compose ran), else
-// relative to the folder.
+// A take's path as written in summary.json: as given, relative to the working directory mmh
+// compose ran in (run.json's working_directory), or in the folder.
 fs::path ResolveInput(const std::string& given, const fs::path& dir, const std::string& what) {
   const fs::path path(given);
   if (fs::exists(path)) return path;
-  if (path.is_relative() && fs::exists(dir / path.filename())) return dir / path.filename();
+  if (path.is_relative()) {
+    if (fs::exists(dir / "run.json")) {
+      const json run = ReadJsonFile(dir / "run.json");
+      if (run.contains("working_directory") && run["working_directory"].is_string()) {
+        const fs::path there = fs::path(run["working_directory"].get<std::string>()) / path;
+        if (fs::exists(there)) return there;
+      }
+    }
+    if (fs::exists(dir / path.filename())) return dir / path.filename();
+  }
   ThrowBadValue(what, given,
-                "a readable file (the report reads the takes mmh compose read: run it where "
-                "compose ran, or copy the file into the folder)");
+                "a readable file (the takes mmh compose read, as given, relative to run.json's "
+                "working_directory, or copied into the folder)");
 }
 
 // Matching cost images (paper Figure 4), sampled evenly to at most size x size cells, as grey

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -195,6 +196,25 @@ TEST(ReportCli, StudyFolderInTheBrowser) {
   ExpectCleanLoad(check);
   EXPECT_EQ(check["kind"], "study");
   EXPECT_FALSE(check["has_view"].get<bool>());
+}
+
+// Takes given relative to where mmh compose ran are found from any working directory (run.json's
+// working_directory).
+TEST(ReportCli, RelativeTakesFromAnotherDirectory) {
+  TempDir dir;
+  for (const char* f : {"take_1.tum", "take_2.tum", "take_1.csv", "take_2.csv"}) {
+    std::filesystem::copy_file(kExample + f, dir / f);
+  }
+  const std::string compose = "cd '" + dir.path().string() + "' && " + MMH_BINARY +
+                              " compose --takes take_1.tum take_2.tum --annotations take_1.csv "
+                              "take_2.csv --no-glb --quiet --out out";
+  ASSERT_EQ(std::system(compose.c_str()), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "montage.glb"));
+  const auto r = RunMmh("report " + (dir / "out").string());  // from the test's directory
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string html = ReadBytes(dir / "out" / "report.html");
+  EXPECT_NE(html.find("\"take_2\""), std::string::npos);
+  EXPECT_EQ(html.find("id=\"mmh-glb\""), std::string::npos);  // --no-glb: no 3D view
 }
 
 TEST(ReportCli, BadFoldersExitTwoAndWriteNothing) {
