@@ -7,6 +7,17 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 
 export const kBackground = 0xf4f4f4;
 
+// True when WebGL runs on a CPU rasteriser (SwiftShader, llvmpipe).
+function softwareRenderer() {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  if (!gl) return false;
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+  const lose = gl.getExtension('WEBGL_lose_context');
+  if (lose) lose.loseContext();
+  return /swiftshader|llvmpipe|software/i.test(name);
+}
+
 export class View3d {
   // montage: {frames, node (the montage node's glTF name)}; onFrame(frame) after every move.
   constructor(host, montage, onFrame) {
@@ -35,7 +46,9 @@ export class View3d {
     controls.append(this.play, this.scrubber, this.label);
     host.append(controls);
 
-    this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: true });
+    // Multisampling triples the cost of a frame in a software rasteriser (SwiftShader: a scrub
+    // step 14 ms without, 41-55 ms with, bench/README.md); GPUs get it.
+    this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: !softwareRenderer() });
     this.renderer.setPixelRatio(1);
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(kBackground);
