@@ -15,6 +15,7 @@
 #include "core/tum_io.h"
 #include "montage/compose.h"
 #include "montage/layered.h"
+#include "report/trajectory_glb.h"
 
 namespace mmh::cli {
 namespace {
@@ -24,6 +25,9 @@ struct ComposeArgs {
   std::vector<std::string> takes;
   std::vector<std::string> annotations;
   std::vector<int> markers;
+  std::string model;
+  double model_scale = 1.0;
+  bool no_glb = false;
 };
 
 void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
@@ -66,6 +70,20 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
     }
   }
 
+  // montage.glb: the montage, every take warped and as recorded, the markers (report/).
+  std::string glb;
+  if (!args.no_glb) {
+    report::MontageObject object;
+    object.mesh = args.model.empty() ? report::OrientedStandIn()
+                                     : report::LoadExportMesh(args.model, args.model_scale);
+    object.montage = montage.trajectory;
+    object.takes = takes;
+    object.warps = montage.warps;
+    object.reference_take = options.reference_take;
+    object.marker_frames = args.markers;
+    glb = report::EncodeGlb(report::MontageScene({object}));
+  }
+
   nlohmann::json resolved;
   resolved["montage"] = ToJson(options);
   nlohmann::json summary = montage::SummaryToJson(montage.summary, montage.segments);
@@ -83,6 +101,7 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
              "spatial markers: montage poses at the marked frames");
   }
   WriteFileAtomically(out / "timeline.csv", montage::TimelineToCsv(montage));
+  if (!glb.empty()) WriteFileAtomically(out / "montage.glb", glb);
   WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
   WriteFileAtomically(
@@ -104,7 +123,8 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
     for (const auto& w : s.warnings) std::cout << "warning: " << w << '\n';
     std::cout << "written: " << out.string() << "/{montage.tum, segments.csv, timeline.csv, "
               << "summary.json, config.resolved.json, run.json"
-              << (marker_poses.empty() ? "" : ", markers.tum") << "}\n";
+              << (marker_poses.empty() ? "" : ", markers.tum") << (glb.empty() ? "" : ", montage.glb")
+              << "}\n";
   }
 }
 
@@ -124,6 +144,11 @@ void AddComposeCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->add_option("--markers", args->markers,
                   "Spatial markers: montage frames (at least 60 apart); writes markers.tum")
       ->expected(1, -1);
+  cmd->add_option("--model", args->model,
+                  "Proxy model for montage.glb: Duplo assembly (.json), .obj or .ply "
+                  "(default: an oriented stand-in)");
+  cmd->add_option("--model-scale", args->model_scale, "Scale of --model (0.001 for millimetres)");
+  cmd->add_flag("--no-glb", args->no_glb, "Do not write montage.glb");
   AddCommonFlags(cmd, &args->common, {.config_help = "JSON config with a 'montage' section"});
   cmd->callback([args, argv] { RunCompose(*args, argv); });
 }

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <functional>
 #include <memory>
 
@@ -60,6 +61,8 @@ nlohmann::json Provenance(const std::vector<std::string>& argv,
                           const nlohmann::json& timings) {
   nlohmann::json run;
   run["command"] = argv;
+  // Relative paths in the command and the results are relative to it (mmh report reads the takes).
+  run["working_directory"] = std::filesystem::current_path().string();
   run["mmh_version"] = MMH_VERSION;
   run["git_commit"] = GitCommit();
   run["config_hash"] = ConfigHash(resolved_config);

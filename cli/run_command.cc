@@ -19,6 +19,7 @@
 #include "pipeline/animator_run.h"
 #include "pipeline/run_metrics.h"
 #include "pipeline/run_output.h"
+#include "report/run_scene.h"
 
 namespace mmh::cli {
 namespace {
@@ -95,6 +96,10 @@ pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animato
     throw;
   }
   pipeline::WriteAnimatorRun(out, run);
+  for (const bool truth : {false, true}) {
+    report::WriteGlb(out / (truth ? "montage_truth" : "montage") / "montage.glb",
+                     report::RunMontageScene(run, truth, config.montage.reference_take));
+  }
   WriteFileAtomically(out / "timings.csv", pipeline::TimingsToCsv(run));
   WriteFileAtomically(
       out / "run.json",

@@ -304,6 +304,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
                                      ? sim::StoryProxyFile(render.render.story, story, object)
                                      : render.render.proxy;
   models.push_back(sim::LoadProxyModel(main_proxy, render.render.proxy_scale));
+  result.proxy_model = models.back();
   model_names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
   if (practice_takes) {
     const std::string practice_proxy = sim::StoryProxyFile(options.practice, *practice_story, 0);

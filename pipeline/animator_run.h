@@ -120,6 +120,7 @@ struct AnimatorRun {
   std::vector<TakeRun> takes;
   montage::Montage montage;        // from the tracked takes and read annotations
   montage::Montage truth_montage;  // from the ground truth
+  TriangleMesh proxy_model;        // the takes' proxy (montage.glb shows it)
   // Latent quality of each montage frame, carried from the takes' frames it shows
   // (sim::CompositeQuality).
   std::vector<double> montage_quality;

@@ -1,0 +1,59 @@
+// mmh's HTML report: reads the data mmh embedded in the page (#mmh-data, #mmh-glb) and draws the
+// report of a compose, run or study folder. Bundled by esbuild at build time (report/CMakeLists.txt);
+// the page needs no network.
+import { annotationSection, dtwSection, segmentSection, tableSection, figureSection, textSection }
+  from './figures.js';
+import { View3d } from './view3d.js';
+
+// Errors are collected for the browser test (report/web/tools/browser_check.js) and shown.
+const errors = [];
+window.addEventListener('error', (event) => errors.push(String(event.message)));
+window.addEventListener('unhandledrejection', (event) => errors.push(String(event.reason)));
+
+function element(tag, attributes = {}, children = []) {
+  const node = document.createElement(tag);
+  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
+  for (const child of children) node.append(child);
+  return node;
+}
+
+function decodeBase64(text) {
+  const binary = atob(text.trim());
+  const bytes = new Uint8Array(binary.length);
+  for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
+  return bytes;
+}
+
+async function main() {
+  const data = JSON.parse(document.getElementById('mmh-data').textContent);
+  const app = document.getElementById('app');
+  app.append(element('h1', {}, [data.title]));
+  app.append(element('p', { class: 'folder' }, [`${data.kind} folder: ${data.folder}`]));
+  const api = { data, errors, view: null, ready: false };
+  window.mmhReport = api;
+
+  if (data.kind === 'compose' || data.kind === 'run') {
+    const glbElement = document.getElementById('mmh-glb');
+    const scrubberHost = element('section', { class: 'view' });
+    app.append(scrubberHost);
+    const listeners = [];
+    if (glbElement) {
+      api.view = new View3d(scrubberHost, data.montage, (frame) => listeners.forEach((f) => f(frame)));
+      await api.view.load(decodeBase64(glbElement.textContent).buffer);
+    }
+    app.append(segmentSection(data, listeners));
+    app.append(annotationSection(data));
+    app.append(dtwSection(data));
+  }
+  for (const figure of data.figures || []) app.append(figureSection(figure));
+  for (const text of data.texts || []) app.append(textSection(text));
+  for (const table of data.tables || []) app.append(tableSection(table));
+  api.ready = true;
+  document.body.dataset.ready = 'true';
+}
+
+main().catch((error) => {
+  errors.push(String(error && error.stack ? error.stack : error));
+  console.error(error);
+  document.body.append(element('pre', { class: 'error' }, [String(error)]));
+});

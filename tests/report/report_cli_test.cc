@@ -1,0 +1,254 @@
+// `mmh export`, montage.glb of `mmh compose` and `mmh run`, and `mmh report` through the binary;
+// every report is loaded in headless Chromium (SwiftShader WebGL) by report/web/tools/
+// browser_check.js: no console error, no network request, the 3D canvas drawn, and the scrubber at
+// frame k shows the montage's pose at k.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "core/tum_io.h"
+#include "report/gltf_scene.h"
+#include "tests/report/glb_test_util.h"
+#include "tests/test_util.h"
+
+namespace mmh {
+namespace {
+
+using test_util::ReadBytes;
+using test_util::RunMmh;
+using test_util::TempDir;
+using test_util::WriteText;
+
+const std::string kSource = MMH_SOURCE_DIR;
+const std::string kExample = kSource + "/examples/synthetic_story/";
+
+std::string Compose(const std::filesystem::path& out, const std::string& extra = "") {
+  return "compose --takes " + kExample + "take_1.tum " + kExample + "take_2.tum " + kExample +
+         "take_3.tum --annotations " + kExample + "take_1.csv " + kExample + "take_2.csv " +
+         kExample + "take_3.csv --quiet --out " + out.string() + " " + extra;
+}
+
+// Runs the browser check on `html`; the parsed JSON (null when it failed, with a test failure).
+nlohmann::json BrowserCheck(const std::filesystem::path& html, const std::vector<int>& frames,
+                            const std::filesystem::path& screenshot = {}) {
+  std::string list;
+  for (int k : frames) list += (list.empty() ? "" : ",") + std::to_string(k);
+  std::string command = "node --experimental-websocket '" + kSource +
+                        "/report/web/tools/browser_check.js' --chromium chromium --html '" +
+                        html.string() + "'";
+  if (!list.empty()) command += " --frames " + list;
+  if (!screenshot.empty()) command += " --screenshot '" + screenshot.string() + "'";
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  std::string output;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  const int status = pclose(pipe);
+  EXPECT_EQ(status, 0) << output;
+  const auto brace = output.rfind("\n{");
+  const std::string json = output.substr(brace == std::string::npos ? 0 : brace + 1);
+  nlohmann::json result = nlohmann::json::parse(json, nullptr, false);
+  EXPECT_FALSE(result.is_discarded()) << output;
+  return result.is_discarded() ? nlohmann::json() : result;
+}
+
+// The page loaded with no console error, exception or network request.
+void ExpectCleanLoad(const nlohmann::json& check) {
+  ASSERT_TRUE(check.is_object());
+  EXPECT_TRUE(check["ready"].get<bool>()) << check.dump(1);
+  EXPECT_TRUE(check["errors"].empty()) << check["errors"].dump(1);
+  EXPECT_TRUE(check["page_errors"].empty()) << check["page_errors"].dump(1);
+  EXPECT_TRUE(check["requests"].empty()) << check["requests"].dump(1);
+}
+
+// The montage node at each checked frame is the montage's pose there (glTF axes, 32-bit floats).
+void ExpectScrubbedPoses(const nlohmann::json& check, const Trajectory& table_T_proxy) {
+  ASSERT_TRUE(check["has_view"].get<bool>());
+  EXPECT_EQ(check["montage_frames"].get<std::size_t>(), table_T_proxy.size());
+  EXPECT_GT(check["pixels"]["count"].get<int>(), 1000) << check["pixels"].dump();
+  const Rigid3 gltf_T_table = report::GltfTFrame(report::TrajectoryFrame::kTable);
+  ASSERT_FALSE(check["poses"].empty());
+  for (const auto& pose : check["poses"]) {
+    const int k = pose["frame"];
+    const Rigid3 expected = gltf_T_table * table_T_proxy.poses[k];
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(pose["position"][c].get<double>(), expected.translation(c), 1e-6) << "frame " << k;
+    }
+    const Eigen::Vector4d q(pose["quaternion"][0], pose["quaternion"][1], pose["quaternion"][2],
+                            pose["quaternion"][3]);
+    const Eigen::Vector4d e = expected.rotation.coeffs();
+    EXPECT_LE(std::min((q - e).cwiseAbs().maxCoeff(), (q + e).cwiseAbs().maxCoeff()), 1e-6)
+        << "frame " << k;
+  }
+  std::printf("[ browser  ] %d montage frames, %d non-background pixels, scrub step %.2f ms, "
+              "playing at %.1f frames/s, loaded in %d ms\n",
+              check["montage_frames"].get<int>(), check["pixels"]["count"].get<int>(),
+              check["scrub_ms"].get<double>(), check["playback_fps"].get<double>(),
+              check["load_ms"].get<int>());
+}
+
+TEST(ExportCli, TumAndModelToGlb) {
+  TempDir dir;
+  const auto out = dir / "take_1.glb";
+  auto r = RunMmh("export --trajectory " + kExample + "take_1.tum --model " + kSource +
+                  "/configs/proxies/soldier.json --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test_util::Glb glb = test_util::ParseGlb(ReadBytes(out));
+  const Trajectory input = ReadTum(kExample + "take_1.tum");
+  Trajectory read = test_util::AnimatedTrajectory(glb, "take_1", "take_1");
+  ASSERT_EQ(read.size(), input.size());
+  const Rigid3 table_T_gltf = report::GltfTFrame(report::TrajectoryFrame::kTable).Inverse();
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    const Rigid3 pose = table_T_gltf * read.poses[i];
+    EXPECT_LE((pose.translation - input.poses[i].translation).cwiseAbs().maxCoeff(), 1e-6);
+    EXPECT_LE(RotationAngle(pose.rotation, input.poses[i].rotation), 2e-6);
+    EXPECT_NEAR(read.timestamps[i], input.timestamps[i], 1e-6);
+  }
+  r = RunMmh("export --trajectory " + kExample + "take_2.tum --frame camera --out " +
+             (dir / "camera.glb").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  test_util::ExpectValidGltf({out, dir / "camera.glb"});
+}
+
+TEST(ExportCli, BadInputExitsTwoAndWritesNothing) {
+  TempDir dir;
+  WriteText(dir / "nan.tum", "0 0 0 0 0 0 0 1\n0.033 nan 0 0 0 0 0 1\n");
+  WriteText(dir / "stretched.tum", "0 0 0 0 0 0 0 1\n0.033 0 0 0 0 0 0 1.5\n");
+  WriteText(dir / "ok.tum", "0 0 0 0 0 0 0 1\n0.033 0 0 0 0 0 0 1\n");
+  WriteText(dir / "broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
+  const auto out = dir / "out";
+  std::filesystem::create_directories(out);
+  struct Case {
+    std::string arguments, expected;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--trajectory " + (dir / "nan.tum").string(), "nan.tum:2"},
+           {"--trajectory " + (dir / "stretched.tum").string(), "stretched.tum:2"},
+           {"--trajectory " + (dir / "ok.tum").string() + " --model " + (dir / "broken.ply").string(),
+            "broken.ply"},
+           {"--trajectory " + (dir / "ok.tum").string() + " --model " + (dir / "missing.obj").string(),
+            "missing.obj"},
+       }) {
+    const auto r = RunMmh("export " + c.arguments + " --out " + (out / "x.glb").string());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << r.output;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(out));
+}
+
+TEST(ReportCli, ComposeFolderInTheBrowser) {
+  TempDir dir;
+  const auto out = dir / "compose";
+  auto r = RunMmh(Compose(out, "--markers 100 400 --model " + kSource + "/configs/proxies/soldier.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  test_util::ExpectValidGltf({out / "montage.glb"});
+  r = RunMmh("report " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string html = ReadBytes(out / "report.html");
+  EXPECT_LT(html.size(), 5u << 20);
+  // Self-contained: no external script, style or image.
+  for (const char* external : {"<script src", "<link", "<img src=\"http", "@import"}) {
+    EXPECT_EQ(html.find(external), std::string::npos) << external;
+  }
+  const Trajectory montage = ReadTum(out / "montage.tum");
+  const int last = static_cast<int>(montage.size()) - 1;
+  const nlohmann::json check = BrowserCheck(out / "report.html", {0, 1, 137, last / 2, last},
+                                            dir / "compose.png");
+  ExpectCleanLoad(check);
+  EXPECT_EQ(check["kind"], "compose");
+  ExpectScrubbedPoses(check, montage);
+  EXPECT_GT(std::filesystem::file_size(dir / "compose.png"), 10000u);
+}
+
+TEST(ReportCli, RunFolderInTheBrowser) {
+  TempDir dir;
+  const auto out = dir / "run";
+  auto r = RunMmh("run --config " + kSource + "/configs/soldier.json --set 'render.story=\"" +
+                  kSource + "/configs/stories/soldier.json\"' --set render.frames=70 --set " +
+                  "run.takes=2 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  test_util::ExpectValidGltf({out / "montage" / "montage.glb", out / "montage_truth" / "montage.glb"});
+  r = RunMmh("report --quiet " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Trajectory montage = ReadTum(out / "montage" / "montage.tum");
+  const nlohmann::json check =
+      BrowserCheck(out / "report.html", {0, static_cast<int>(montage.size()) - 1});
+  ExpectCleanLoad(check);
+  EXPECT_EQ(check["kind"], "run");
+  ExpectScrubbedPoses(check, montage);
+}
+
+TEST(ReportCli, StudyFolderInTheBrowser) {
+  TempDir dir;
+  const auto out = dir / "study";
+  auto r = RunMmh("study --config " + kSource + "/configs/study_soldier.json --set render.story=" +
+                  kSource + "/configs/stories/soldier.json --set run.practice=" + kSource +
+                  "/configs/stories/mario.json --set run.fidelity=fast --set study.animators=4 " +
+                  "--set render.frames=600 --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = RunMmh("report " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string html = ReadBytes(out / "report.html");
+  EXPECT_NE(html.find("Figure 8"), std::string::npos);
+  const nlohmann::json check = BrowserCheck(out / "report.html", {});
+  ExpectCleanLoad(check);
+  EXPECT_EQ(check["kind"], "study");
+  EXPECT_FALSE(check["has_view"].get<bool>());
+}
+
+// Takes given relative to where mmh compose ran are found from any working directory (run.json's
+// working_directory).
+TEST(ReportCli, RelativeTakesFromAnotherDirectory) {
+  TempDir dir;
+  for (const char* f : {"take_1.tum", "take_2.tum", "take_1.csv", "take_2.csv"}) {
+    std::filesystem::copy_file(kExample + f, dir / f);
+  }
+  const std::string compose = "cd '" + dir.path().string() + "' && " + MMH_BINARY +
+                              " compose --takes take_1.tum take_2.tum --annotations take_1.csv "
+                              "take_2.csv --no-glb --quiet --out out";
+  ASSERT_EQ(std::system(compose.c_str()), 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "montage.glb"));
+  const auto r = RunMmh("report " + (dir / "out").string());  // from the test's directory
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string html = ReadBytes(dir / "out" / "report.html");
+  EXPECT_NE(html.find("\"take_2\""), std::string::npos);
+  EXPECT_EQ(html.find("id=\"mmh-glb\""), std::string::npos);  // --no-glb: no 3D view
+}
+
+TEST(ReportCli, BadFoldersExitTwoAndWriteNothing) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "other");
+  WriteText(dir / "other" / "notes.txt", "not an output folder\n");
+  auto r = RunMmh("report " + (dir / "other").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("expected the output of mmh compose"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "other" / "report.html"));
+
+  // compose with a model that cannot be read: nothing written.
+  WriteText(dir / "broken.obj", "v 0 0 nan\nf 1 2 3\n");
+  r = RunMmh(Compose(dir / "bad_model", "--model " + (dir / "broken.obj").string()));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("broken.obj"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad_model"));
+
+  // A compose folder whose takes are gone.
+  const auto out = dir / "compose";
+  std::filesystem::create_directories(dir / "takes");
+  for (const char* f : {"take_1.tum", "take_2.tum", "take_1.csv", "take_2.csv"}) {
+    std::filesystem::copy_file(kExample + f, dir / "takes" / f);
+  }
+  const std::string t = (dir / "takes").string() + "/";
+  r = RunMmh("compose --takes " + t + "take_1.tum " + t + "take_2.tum --annotations " + t +
+             "take_1.csv " + t + "take_2.csv --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::filesystem::remove(dir / "takes" / "take_2.tum");
+  r = RunMmh("report " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("take_2.tum"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "report.html"));
+}
+
+}  // namespace
+}  // namespace mmh
