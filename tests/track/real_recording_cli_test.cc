@@ -121,3 +121,26 @@ TEST(RealRecordingCliTest, BadInputsNameTheFileAndTheValue) {
 
 }  // namespace
 }  // namespace mmh
+
+namespace mmh {
+namespace {
+
+// A TUM-layout folder (camera.json, groundtruth.txt) is evaluated the same way: a rendered take's
+// own ground truth as the estimate scores perfectly.
+TEST(RealRecordingCliTest, EvalOfATumFolderWithCameraJson) {
+  TempDir dir;
+  const fs::path take = dir / "take";
+  const auto render = RunMmh("render --quiet --out " + take.string() + " --set render.frames=4");
+  ASSERT_EQ(render.exit_code, 0) << render.output;
+  const auto result = RunMmh("eval --quiet --input " + take.string() + " --model " +
+                             (take / "model.ply").string() + " --estimate " +
+                             (take / "groundtruth.txt").string() + " --out " + (dir / "e").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto o = nlohmann::json::parse(ReadBytes(dir / "e" / "eval.json"))["objects"][0];
+  EXPECT_EQ(o["frames"], 4);
+  EXPECT_EQ(o["ar"], 1.0);
+  EXPECT_EQ(o["median_translation_mm"], 0.0);
+}
+
+}  // namespace
+}  // namespace mmh
