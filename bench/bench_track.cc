@@ -9,14 +9,19 @@
 #include <benchmark/benchmark.h>
 
 #include <optional>
+#include <tuple>
 #include <vector>
 
+#include "core/config.h"
+#include "core/mesh_io.h"
 #include "metrics/tracking_metrics.h"
 #include "tests/track/sim_take.h"
 #include "track/internal/pcl_icp_baseline.h"
 #include "track/proxy_tracker.h"
 #include "track/segmentation.h"
+#include "track/recording.h"
 #include "track/table_plane.h"
+#include "track/track_session.h"
 
 namespace mmh::track {
 namespace {
@@ -150,6 +155,38 @@ void BM_PclIcpWithNormals(benchmark::State& state) {
   SetAccuracy(state, take, estimates);
 }
 BENCHMARK(BM_PclIcpWithNormals)->Unit(benchmark::kMillisecond);
+
+// Real frames: the committed YCB-Video excerpt (tests/data/real/ycbv, Asus Xtion 640x480), the
+// foam brick tracked with configs/track_real.json from the ground truth's first pose, all ten
+// frames per repetition (the table plane and the first frame's window included).
+//
+//   ./bench_track --benchmark_filter=BM_RealRecording
+void BM_RealRecording(benchmark::State& state) {
+  static const auto data = [] {
+    const std::string root = std::string(MMH_BENCH_SOURCE_DIR) + "/tests/data/real/ycbv";
+    RecordingFrameSource source(root + "/data/0000");
+    std::vector<RgbdFrame> frames;
+    RgbdFrame frame;
+    while (source.Next(&frame)) frames.push_back(frame);
+    return std::make_tuple(frames, source.Truth(21), LoadMesh(root + "/models/061_foam_brick.obj"),
+                           TrackConfig::FromConfig(Config::Load(
+                               std::string(MMH_BENCH_SOURCE_DIR) + "/configs/track_real.json")));
+  }();
+  const auto& [frames, truth, model, config] = data;
+  TrackSetup setup;
+  setup.play_area_width = config.run.play_area_width;
+  setup.play_area_depth = config.run.play_area_depth;
+  int64_t tracked = 0;
+  for (auto _ : state) {
+    ProxyTracker tracker(model, "foam brick", setup, config.tracker);
+    tracker.Initialize(truth.poses.front());
+    for (const RgbdFrame& f : frames) tracked += tracker.Track(f).status == TrackStatus::kTracked;
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frames.size()));
+  state.counters["tracked_share"] =
+      static_cast<double>(tracked) / (state.iterations() * static_cast<double>(frames.size()));
+}
+BENCHMARK(BM_RealRecording)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace mmh::track

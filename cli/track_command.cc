@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
+#include <algorithm>
 #include <memory>
 #include <stdexcept>
 
@@ -16,7 +17,9 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/mesh_io.h"
+#include "core/tum_io.h"
 #include "track/frame_source.h"
+#include "track/recording.h"
 #include "track/freenect_source.h"
 #include "track/track_session.h"
 
@@ -29,6 +32,46 @@ struct TrackArgs {
   std::string model;
   std::string setup;
 };
+
+// A model far larger than any tracked object is almost always one in millimetres read as metres.
+void CheckModelSize(const TriangleMesh& model, const std::string& name,
+                    const track::TrackRunOptions& run) {
+  const Bounds3 bounds = ComputeBounds(model);
+  if (bounds.empty()) return;  // LoadMesh has rejected an empty model already
+  const double size = (bounds.max - bounds.min).norm();
+  if (size > run.max_model_size) {
+    throw InputError("--model " + name + ": the model is " + FormatNumber(size) +
+                     " m across (bounding-box diagonal, at run.model_scale " +
+                     FormatNumber(run.model_scale) + "), expected at most run.max_model_size = " +
+                     FormatNumber(run.max_model_size) +
+                     " m: a model in millimetres (BOP) needs --set run.model_scale=0.001");
+  }
+}
+
+// The object a recording's run follows: run.object, or the only one annotated.
+int ChooseObject(const track::RecordingFrameSource& recording, int object) {
+  const std::vector<int> ids = recording.object_ids();
+  std::string list;
+  for (int id : ids) list += (list.empty() ? "" : ", ") + std::to_string(id);
+  if (object == 0) {
+    if (ids.size() == 1) return ids[0];
+    ThrowBadValue("run.object", "0 (the only one)",
+                  "one of the objects annotated in " + recording.Describe() + ": " + list);
+  }
+  if (std::find(ids.begin(), ids.end(), object) == ids.end()) {
+    ThrowBadValue("run.object", std::to_string(object),
+                  "one of the objects annotated in " + recording.Describe() + ": " + list);
+  }
+  return object;
+}
+
+// The first frame's true pose when run.init is truth.
+std::optional<Rigid3> FirstTruePose(const std::optional<Trajectory>& truth,
+                                    const track::TrackRunOptions& run) {
+  if (run.init != track::TrackInit::kTruth || !truth) return std::nullopt;
+  if (truth->empty()) throw InputError("run.init = truth: the object has no ground truth");
+  return truth->poses.front();
+}
 
 void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   namespace fs = std::filesystem;
@@ -64,9 +107,18 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
     setup = track::ReadSetupJson(setup_file);
     calibrated = true;
   }
+  if (track_config.run.proxy) CheckModelSize(model, args.model, track_config.run);
   std::unique_ptr<track::FrameSource> source;
+  // A real recording with ground truth (BOP scene, YCB-Video folder): the followed object's truth
+  // is written beside the trajectory (groundtruth.tum) and may give the first pose.
+  std::optional<Trajectory> truth;
   if (live) {
     source = std::make_unique<track::FreenectFrameSource>(track_config.freenect);
+  } else if (track::DetectRecordingLayout(args.input)) {
+    auto recording =
+        std::make_unique<track::RecordingFrameSource>(args.input, track_config.run.frame_rate);
+    truth = recording->Truth(ChooseObject(*recording, track_config.run.object));
+    source = std::move(recording);
   } else {
     source = std::make_unique<track::FolderFrameSource>(
         args.input, track_config.run.override_intrinsics
@@ -82,7 +134,8 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                                                      if (total > 0) std::cerr << " / " << total;
                                                      std::cerr << " frames" << std::flush;
                                                    }
-                                                 });
+                                                 },
+                                                 FirstTruePose(truth, track_config.run));
   if (bar) std::cerr << '\n';
 
   const fs::path out = args.common.out_dir;
@@ -95,6 +148,11 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
   WriteFileAtomically(out / "run.json",
                       Provenance(argv, resolved, args.common.threads, timings).dump(2) + "\n");
+  if (truth) {
+    WriteTum(out / "groundtruth.tum", *truth,
+             "camera_T_object of the followed object, from the recording's ground truth");
+    written.push_back("groundtruth.tum");
+  }
   written.push_back("config.resolved.json");
   written.push_back("run.json");
   if (!args.common.quiet) {
@@ -142,7 +200,8 @@ void AddTrackCommand(CLI::App& app, const std::vector<std::string>& argv) {
       "Tracker on a frame source: proxy trajectory (TUM), per-frame status, slider "
       "annotation (CSV)");
   cmd->add_option("--input", args->input,
-                  "A TUM RGB-D folder (ours or a public sequence), or 'freenect' for a Kinect v1")
+                  "A TUM RGB-D folder (ours or a public sequence), a real recording with ground "
+                  "truth (BOP scene, YCB-Video folder), or 'freenect' for a Kinect v1")
       ->required();
   cmd->add_option("--model", args->model,
                   "The proxy's mesh (.ply or .obj), e.g. model.ply of a rendered take; "

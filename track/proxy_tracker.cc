@@ -148,6 +148,14 @@ ProxyTracker::ProxyTracker(const TriangleMesh& model, const std::string& model_n
 
 ProxyTracker::~ProxyTracker() = default;
 
+void ProxyTracker::Initialize(const Rigid3& camera_T_proxy) {
+  motion_->Reset();
+  motion_->Measure(camera_T_proxy, false);
+  predicted_frames_ = 0;
+  tracked_frames_ = 0;
+  frames_since_detection_ = 0;
+}
+
 TrackFrameResult ProxyTracker::Unreadable(const RgbdFrame& frame, const std::string& error) {
   TrackFrameResult result;
   result.index = frame.index;

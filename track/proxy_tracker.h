@@ -249,6 +249,11 @@ class ProxyTracker {
                const ProxyTrackerOptions& options);
   ~ProxyTracker();
 
+  // Starts the track at a known pose (the ground truth's first pose of a recording, when a run
+  // asks for it): the next Track() refines this pose as a prediction instead of detecting the
+  // object; a loss after that detects as usual.
+  void Initialize(const Rigid3& camera_T_proxy);
+
   // Tracks one frame. Never throws for a bad frame: a frame of the wrong size, with other
   // intrinsics than the first, without depth or without a table is lost with the reason.
   TrackFrameResult Track(const RgbdFrame& frame);

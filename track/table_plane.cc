@@ -137,6 +137,10 @@ std::optional<TablePlane> EstimateTablePlane(const RgbdFrame& frame,
       }
       return std::nullopt;
     }
+  } else if (options.largest) {
+    for (const TablePlane& plane : planes) {
+      if (!best || plane.inliers > best->inliers) best = &plane;
+    }
   } else {
     const Eigen::Vector3d up(0, -1, 0);  // image up
     double best_angle = 1e300;

@@ -29,6 +29,10 @@ struct TablePlaneOptions {
   double max_calibration_angle_deg = 15.0;
   double max_calibration_distance = 0.05;
   double up_tolerance_deg = 15.0;
+  // Without a calibration, take the plane with the most inliers instead: a real recording whose
+  // camera looks steeply down at a cluttered table (YCB-Video) has box tops whose normals are
+  // nearer the image's up than the table's.
+  bool largest = false;
 
   template <class V>
   void VisitFields(V& v) {
@@ -40,6 +44,7 @@ struct TablePlaneOptions {
     v("max_calibration_angle_deg", max_calibration_angle_deg);
     v("max_calibration_distance", max_calibration_distance);
     v("up_tolerance_deg", up_tolerance_deg);
+    v("largest", largest);
   }
   void Validate(const std::string& prefix) const;
 };

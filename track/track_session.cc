@@ -16,8 +16,19 @@ std::span<const std::pair<OutputFrame, const char*>> EnumNames(OutputFrame) {
   return kNames;
 }
 
+std::span<const std::pair<TrackInit, const char*>> EnumNames(TrackInit) {
+  static constexpr std::pair<TrackInit, const char*> kNames[] = {{TrackInit::kDetection, "detection"},
+                                                                 {TrackInit::kTruth, "truth"}};
+  return kNames;
+}
+
 void TrackRunOptions::Validate(const std::string& prefix) const {
   RequirePositive(model_scale, prefix + ".model_scale");
+  if (object < 0) ThrowBadValue(prefix + ".object", std::to_string(object), ">= 0 (0: the only one)");
+  RequirePositive(frame_rate, prefix + ".frame_rate", "Hz");
+  RequireNonNegative(play_area_width, prefix + ".play_area_width", "m");
+  RequireNonNegative(play_area_depth, prefix + ".play_area_depth", "m");
+  RequirePositive(max_model_size, prefix + ".max_model_size", "m");
   if (override_intrinsics) intrinsics.Validate(prefix + ".intrinsics");
   if (max_frames < 0) {
     ThrowBadValue(prefix + ".max_frames", std::to_string(max_frames), ">= 0 (0: all)");
@@ -44,7 +55,7 @@ nlohmann::json TrackConfig::ToJson() const {
 nlohmann::json TrackSummary::ToJson() const {
   return {{"frames", frames},         {"tracked", tracked},
           {"predicted", predicted},   {"lost", lost},
-          {"detections", detections}, {"slider_found", slider_found},
+          {"detections", detections}, {"slider_found", slider_found}, {"init", init},
           {"seconds", seconds},       {"frames_per_second", seconds > 0 ? frames / seconds : 0.0}};
 }
 
@@ -103,8 +114,13 @@ class SliderOnlyTable {
 
 TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::string& model_name,
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
-                     const std::function<void(int, int)>& progress) {
+                     const std::function<void(int, int)>& progress,
+                     const std::optional<Rigid3>& initial_camera_T_proxy) {
   config.run.Validate("run");
+  if (config.run.init == TrackInit::kTruth && !initial_camera_T_proxy && config.run.proxy) {
+    throw InputError("run.init = truth needs a recording with ground truth (a BOP scene or a "
+                     "YCB-Video folder) for the first frame's pose");
+  }
   const bool slider_only = !config.run.proxy;
   if (slider_only) {
     if (!config.run.slider) {
@@ -123,13 +139,23 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
   }
   // Slider-only mode builds no proxy model (the model may be empty).
   std::optional<ProxyTracker> tracker;
-  if (!slider_only) tracker.emplace(model, model_name, setup, config.tracker);
+  if (!slider_only) {
+    // A recording's play area (TrackRunOptions::play_area_*) replaces the setup's.
+    TrackSetup tracked_setup = setup;
+    if (config.run.play_area_width > 0) tracked_setup.play_area_width = config.run.play_area_width;
+    if (config.run.play_area_depth > 0) tracked_setup.play_area_depth = config.run.play_area_depth;
+    tracker.emplace(model, model_name, tracked_setup, config.tracker);
+    if (config.run.init == TrackInit::kTruth && initial_camera_T_proxy) {
+      tracker->Initialize(*initial_camera_T_proxy);
+    }
+  }
   SliderOnlyTable slider_table(config.tracker.table, setup.camera_T_table);
   std::optional<SliderReader> slider;
   if (config.run.slider && setup_calibrated && setup.has_like_box()) {
     slider.emplace(setup, config.slider);
   }
   TrackRun run;
+  run.summary.init = config.run.init == TrackInit::kTruth ? "truth" : "detection";
   RgbdFrame frame;
   double last_value = 0.0;
   using Clock = std::chrono::steady_clock;

@@ -29,6 +29,12 @@ namespace mmh::track {
 enum class OutputFrame { kCamera, kTable };
 std::span<const std::pair<OutputFrame, const char*>> EnumNames(OutputFrame);
 
+// Where the track starts: the global detection on the first frame, or the recording's ground
+// truth of the first frame (a flag the summary records: accuracy from the tracker's own
+// initialisation and from a given one are different claims).
+enum class TrackInit { kDetection, kTruth };
+std::span<const std::pair<TrackInit, const char*>> EnumNames(TrackInit);
+
 struct TrackRunOptions {
   OutputFrame output_frame = OutputFrame::kCamera;
   // The model file's unit [m per unit] (0.001 for a model in millimetres).
@@ -49,6 +55,19 @@ struct TrackRunOptions {
   PinholeIntrinsics intrinsics;
   // Stop after this many frames (0: all).
   int max_frames = 0;
+  // Real recordings (BOP, YCB-Video: track/recording.h): the first frame's pose from `init`; the
+  // object followed (its id in the recording; 0: the only one); frames per second for the
+  // timestamps (the formats have none).
+  TrackInit init = TrackInit::kDetection;
+  int object = 0;
+  double frame_rate = 30.0;
+  // The play area [m] (0: the setup's): a recording without a taped play area gives a large one
+  // (the objects stand anywhere on the table).
+  double play_area_width = 0.0;
+  double play_area_depth = 0.0;
+  // A model larger than this [m, bounding-box diagonal after model_scale] is an input error: a
+  // model in millimetres read as metres (1000 times too big) is the usual cause.
+  double max_model_size = 3.0;
 
   template <class V>
   void VisitFields(V& v) {
@@ -59,6 +78,12 @@ struct TrackRunOptions {
     v("override_intrinsics", override_intrinsics);
     v("intrinsics", intrinsics);
     v("max_frames", max_frames);
+    v("init", init);
+    v("object", object);
+    v("frame_rate", frame_rate);
+    v("play_area_width", play_area_width);
+    v("play_area_depth", play_area_depth);
+    v("max_model_size", max_model_size);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -82,6 +107,8 @@ struct TrackSummary {
   int detections = 0;  // frames whose pose came from the global detection
   int slider_found = 0;
   double seconds = 0.0;  // tracking and slider reading, reading frames excluded
+  // "detection", or "truth" when the first pose came from the ground truth.
+  std::string init = "detection";
   nlohmann::json ToJson() const;
 };
 
@@ -103,9 +130,11 @@ struct TrackRun {
 // (without a calibration the table frame is the estimated one, where the Like box is unknown).
 // With config.run.proxy false (slider-only mode) `model` is not used (it may be empty), and a
 // missing calibration or Like box, or run.slider false, is an InputError before the first frame.
+// `initial_camera_T_proxy`: the first frame's pose when config.run.init is truth (required then).
 TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::string& model_name,
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
-                     const std::function<void(int, int)>& progress = {});
+                     const std::function<void(int, int)>& progress = {},
+                     const std::optional<Rigid3>& initial_camera_T_proxy = std::nullopt);
 
 // Writes status.csv, annotation.csv (when the slider was read), trajectory.tum (when any frame
 // was not lost) and track_summary.json into `out` (created), each atomically. Returns the names

@@ -1,0 +1,67 @@
+// `mmh eval`'s work: a tracked object's poses against a recording's ground truth, frame by frame,
+// with every error of metrics/bop_errors.h and metrics/tracking_metrics.h, summarised per object
+// as BOP's average recall and the 5 deg / 5 cm and 2 deg / 2 cm recalls; written as tidy CSV
+// (one row per object and frame; one row per object) and JSON.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/rigid3.h"
+#include "core/triangle_mesh.h"
+#include "metrics/bop_errors.h"
+
+namespace mmh::metrics {
+
+struct PoseEvaluationOptions {
+  // Area-uniform surface points added to a model with fewer vertices (ErrorPoints).
+  int surface_points = 1000;
+  // VSD needs the test depth image and two renderings per frame; false: MSSD and MSPD only.
+  bool vsd = true;
+  BopRecallOptions bop;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("surface_points", surface_points);
+    v("vsd", vsd);
+    v("bop", bop);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+struct EvaluationFrame {
+  int frame = 0;          // index in the recording
+  double timestamp = 0.0;  // [s]
+  Rigid3 camera_T_truth;
+  std::optional<Rigid3> camera_T_estimate;  // nullopt: no estimate (lost)
+  PinholeIntrinsics intrinsics;
+  // The test image's distance image (DepthToDistance); empty: no VSD for this frame.
+  std::vector<float> test_distance;
+};
+
+struct ObjectEvaluation {
+  int object = 0;
+  double diameter = 0.0;  // [m], over the error points
+  int points = 0;         // error points
+  std::vector<EvaluationFrame> frames;  // without the distance images
+  std::vector<BopFrameErrors> errors;   // per frame
+  BopRecall recall;
+};
+
+// Errors of every frame and their summary. `symmetries`: object_T_symmetric (BOP's discrete
+// symmetries; the identity is implied).
+ObjectEvaluation EvaluateObject(int object, std::vector<EvaluationFrame> frames,
+                                const TriangleMesh& model, const std::vector<Rigid3>& symmetries,
+                                const PoseEvaluationOptions& options);
+
+// Tidy tables: object,frame,timestamp,has_estimate,rotation_deg,translation_mm,add_mm,adds_mm,
+// mssd_mm,mspd_px,vsd_mean (empty without VSD), one row per object and frame; and
+// object,frames,diameter_mm,ar,ar_vsd,ar_mssd,ar_mspd,add_recall,adds_recall,recall_5deg_5cm,
+// recall_2deg_2cm,median_rotation_deg,median_translation_mm, one row per object.
+std::string FramesCsv(const std::vector<ObjectEvaluation>& objects);
+std::string ObjectsCsv(const std::vector<ObjectEvaluation>& objects);
+nlohmann::json ToJson(const ObjectEvaluation& evaluation);
+
+}  // namespace mmh::metrics

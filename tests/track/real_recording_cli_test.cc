@@ -1,0 +1,146 @@
+// `mmh track` and `mmh eval` on the committed real YCB-Video frames (tests/data/real/ycbv): the
+// gelatin box and the foam brick tracked from the ground truth's first pose, scored by `mmh eval` against the dataset's poses; and the bad inputs
+// the issue names (a model 1000 times too big, a recording without a depth scale, inconsistent
+// ground truth): exit code 2 with the file and the value.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "core/tum_io.h"
+#include "tests/test_util.h"
+
+namespace mmh {
+namespace {
+
+namespace fs = std::filesystem;
+using test_util::ReadBytes;
+using test_util::RunMmh;
+using test_util::TempDir;
+using test_util::WriteText;
+using ::testing::HasSubstr;
+
+const fs::path kReal = fs::path(MMH_TEST_DATA_DIR) / "real" / "ycbv";
+const fs::path kVideo = kReal / "data" / "0000";
+const std::string kPreset = std::string(MMH_SOURCE_DIR) + "/configs/track_real.json";
+
+struct Scores {
+  double median_rotation_deg, median_translation_mm, recall_5deg_5cm, ar;
+};
+
+Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, const std::string& init) {
+  const fs::path out = dir / ("track_" + init);
+  const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
+                            (kReal / "models" / model).string() + " --config " + kPreset +
+                            " --set run.object=" + std::to_string(object) +
+                            " --set run.init=\\\"" + init + "\\\" --out " + out.string());
+  EXPECT_EQ(track.exit_code, 0) << track.output;
+  const auto summary = nlohmann::json::parse(ReadBytes(out / "track_summary.json"));
+  EXPECT_EQ(summary["init"], init);
+  EXPECT_TRUE(fs::exists(out / "groundtruth.tum"));
+  const fs::path eval = dir / ("eval_" + init);
+  const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model " +
+                             (kReal / "models" / model).string() + " --estimate " +
+                             (out / "trajectory.tum").string() + " --set run.object=" +
+                             std::to_string(object) + " --out " + eval.string());
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  const auto json = nlohmann::json::parse(ReadBytes(eval / "eval.json"));
+  const auto& o = json["objects"][0];
+  EXPECT_EQ(o["frames"], 10);
+  EXPECT_FALSE(o["ar_vsd"].is_null());
+  return {o["median_rotation_deg"], o["median_translation_mm"], o["recall_5deg_5cm"], o["ar"]};
+}
+
+TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromTheTruthsFirstPose) {
+  TempDir dir;
+  for (const auto& [object, model] :
+       {std::pair<int, std::string>{8, "009_gelatin_box.obj"}, {21, "061_foam_brick.obj"}}) {
+    SCOPED_TRACE(model);
+    const Scores truth = TrackAndEval(dir, object, model, "truth");
+    // Measured 1.13 deg / 1.71 mm (box) and 2.52 deg / 1.97 mm (brick), all 10 frames within
+    // 5 deg / 5 cm, AR 1.0 and 0.974 (docs/tracker.md, "Real recordings"); bounds with margin.
+    // From the tracker's own detection both are lost on every frame (not tested here: see the
+    // doc).
+    EXPECT_LT(truth.median_rotation_deg, 4.0);
+    EXPECT_LT(truth.median_translation_mm, 4.0);
+    EXPECT_GE(truth.recall_5deg_5cm, 0.9);
+    EXPECT_GE(truth.ar, 0.9);
+  }
+}
+
+TEST(RealRecordingCliTest, EvalOfTheTruthItselfIsPerfect) {
+  TempDir dir;
+  // The ground truth as the estimate: every error 0, every recall 1.
+  const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
+                            (kReal / "models" / "061_foam_brick.obj").string() + " --config " +
+                            kPreset + " --set run.object=21 --set run.init=\\\"truth\\\" --out " +
+                            (dir / "t").string());
+  ASSERT_EQ(track.exit_code, 0) << track.output;
+  const auto result = RunMmh("eval --input " + kVideo.string() + " --model " +
+                             (kReal / "models" / "061_foam_brick.obj").string() + " --estimate " +
+                             (dir / "t" / "groundtruth.tum").string() +
+                             " --set run.object=21 --out " + (dir / "e").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto o = nlohmann::json::parse(ReadBytes(dir / "e" / "eval.json"))["objects"][0];
+  EXPECT_EQ(o["ar"], 1.0);
+  EXPECT_EQ(o["recall_2deg_2cm"], 1.0);
+  EXPECT_THAT(ReadBytes(dir / "e" / "eval_frames.csv"),
+              HasSubstr("object,frame,timestamp,has_estimate,rotation_deg"));
+}
+
+TEST(RealRecordingCliTest, BadInputsNameTheFileAndTheValue) {
+  TempDir dir;
+  // A model 1000 times too big (millimetres read as metres).
+  const auto big = RunMmh("track --input " + kVideo.string() + " --model " +
+                          (kReal / "models" / "061_foam_brick.obj").string() + " --config " +
+                          kPreset + " --set run.object=21 --set run.model_scale=1000 --out " +
+                          (dir / "a").string());
+  EXPECT_EQ(big.exit_code, 2) << big.output;
+  EXPECT_THAT(big.output, HasSubstr("061_foam_brick.obj: the model is"));
+  EXPECT_THAT(big.output, HasSubstr("run.model_scale=0.001"));
+  EXPECT_FALSE(fs::exists(dir / "a"));
+  // Several objects and none chosen.
+  const auto none = RunMmh("track --input " + kVideo.string() + " --model " +
+                           (kReal / "models" / "061_foam_brick.obj").string() + " --out " +
+                           (dir / "b").string());
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_THAT(none.output, HasSubstr("8, 14, 21"));
+  // A frame whose ground truth has no depth factor.
+  TempDir copy;
+  fs::copy_file(kVideo / "000001-depth.png", copy / "000001-depth.png");
+  WriteText(copy / "000001-meta.txt",
+            "intrinsic_matrix: 3 3\n1066 0 0 0 1067 0 313 241 1\ncls_indexes: 1 1\n21\n"
+            "poses: 3 4 1\n1 0 0 0 1 0 0 0 1 0 0 0.6\n");
+  const auto scale = RunMmh("track --input " + copy.path().string() + " --model " +
+                            (kReal / "models" / "061_foam_brick.obj").string() + " --out " +
+                            (dir / "c").string());
+  EXPECT_EQ(scale.exit_code, 2) << scale.output;
+  EXPECT_THAT(scale.output, HasSubstr("000001-meta.txt: variable 'factor_depth' is missing"));
+}
+
+}  // namespace
+}  // namespace mmh
+
+namespace mmh {
+namespace {
+
+// A TUM-layout folder (camera.json, groundtruth.txt) is evaluated the same way: a rendered take's
+// own ground truth as the estimate scores perfectly.
+TEST(RealRecordingCliTest, EvalOfATumFolderWithCameraJson) {
+  TempDir dir;
+  const fs::path take = dir / "take";
+  const auto render = RunMmh("render --quiet --out " + take.string() + " --set render.frames=4");
+  ASSERT_EQ(render.exit_code, 0) << render.output;
+  const auto result = RunMmh("eval --quiet --input " + take.string() + " --model " +
+                             (take / "model.ply").string() + " --estimate " +
+                             (take / "groundtruth.txt").string() + " --out " + (dir / "e").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto o = nlohmann::json::parse(ReadBytes(dir / "e" / "eval.json"))["objects"][0];
+  EXPECT_EQ(o["frames"], 4);
+  EXPECT_EQ(o["ar"], 1.0);
+  EXPECT_EQ(o["median_translation_mm"], 0.0);
+}
+
+}  // namespace
+}  // namespace mmh
