@@ -242,7 +242,9 @@ TEST_F(SweepCliTest, FailedAndKilledCellsAreRecordedTheSweepGoesOnAndARerunFinis
 
 TEST_F(SweepCliTest, ASweepKilledWithSigkillResumesWithoutLostOrDuplicatedCells) {
   json spec = ComposeSpec();
-  spec["axes"][1]["values"] = {0, 30, 60, 90};
+  spec["axes"][1]["values"] = {0, 30, 60};
+  // The clean run for comparison packs its cells (same cells: packing is not part of a cell).
+  const fs::path packed = WriteSpec(spec, "packed.json");
   spec["cells_per_worker"] = 1;
   const fs::path file = WriteSpec(spec);
   const fs::path dir = temp_ / "k";
@@ -272,7 +274,7 @@ TEST_F(SweepCliTest, ASweepKilledWithSigkillResumesWithoutLostOrDuplicatedCells)
   waitpid(pid, &wstatus, 0);
   ASSERT_TRUE(WIFSIGNALED(wstatus));
   const int before = complete();
-  ASSERT_LT(before, 12) << "the sweep finished before it could be killed";
+  ASSERT_LT(before, 9) << "the sweep finished before it could be killed";
   std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the worker dies with it
   const auto resumed = RunMmh("sweep --jobs 2 --spec " + file.string() + " --out " + dir.string());
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
@@ -283,8 +285,8 @@ TEST_F(SweepCliTest, ASweepKilledWithSigkillResumesWithoutLostOrDuplicatedCells)
     ++cells;
     EXPECT_EQ(e.path().filename().string().front() != '.', true) << e.path();
   }
-  EXPECT_EQ(cells, 12);
-  ASSERT_EQ(RunMmh("sweep --quiet --spec " + file.string() + " --out " +
+  EXPECT_EQ(cells, 9);
+  ASSERT_EQ(RunMmh("sweep --quiet --spec " + packed.string() + " --out " +
                    (temp_ / "clean").string()).exit_code, 0);
   EXPECT_EQ(ReadBytes(dir / "results.csv"), ReadBytes(temp_ / "clean" / "results.csv"));
   EXPECT_EQ(CellOutputs(dir), CellOutputs(temp_ / "clean"));
