@@ -1,6 +1,11 @@
 #include "cli/command_registry.h"
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
+#include <exception>
+#include <iostream>
+
+#include "core/error.h"
 
 namespace mmh::cli {
 namespace {
@@ -20,6 +25,28 @@ std::vector<RegisteredCommand> RegisteredCommands() {
       commands.begin(), commands.end(),
       [](const RegisteredCommand& a, const RegisteredCommand& b) { return a.order < b.order; });
   return commands;
+}
+
+int ParseAndRun(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  } catch (const mmh::InputError& e) {
+    std::cerr << "mmh: error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "mmh: failed: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
 }
 
 bool RegisterCommand(int order, AddCommandFunction add) {

@@ -27,6 +27,11 @@ struct RegisteredCommand {
 // Every registered command, sorted by order (ties by registration, which is unspecified).
 std::vector<RegisteredCommand> RegisteredCommands();
 
+// Parses the command line into `app` and runs the chosen subcommand; returns the exit code (0 ok,
+// 1 failure of the work, 2 bad input or usage) after printing any error to stderr. main() and the
+// sweep worker (which runs cells in-process) share it.
+int ParseAndRun(CLI::App& app, int argc, char** argv);
+
 // Called by MMH_REGISTER_COMMAND during static initialisation.
 bool RegisterCommand(int order, AddCommandFunction add);
 

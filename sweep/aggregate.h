@@ -1,0 +1,54 @@
+// Gathering a sweep's results (DIR/results.csv, failures.csv, summary.csv, variance_shares.csv and
+// plots/*.svg) from its cell folders. Everything is a function of the plan and the cells'
+// outputs, so the tables are the same bytes whichever backend ran the cells.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sweep/plan.h"
+
+namespace mmh::sweep {
+
+// One row of results.csv: a complete cell and its metrics.
+struct ResultRow {
+  int cell = 0;  // index in the plan
+  std::vector<double> metrics;  // spec.metrics order
+};
+
+struct Aggregate {
+  std::vector<ResultRow> rows;
+  int complete = 0;
+  int failed = 0;  // including cells whose metric could not be read
+  int missing = 0;
+  std::string results_csv;
+  std::string failures_csv;
+  std::string summary_csv;
+  std::string variance_csv;
+  std::vector<std::pair<std::string, std::string>> plots;  // file name, SVG
+};
+
+// Reads every cell and computes the tables and plots (writes nothing).
+Aggregate AggregateSweep(const Plan& plan, const std::filesystem::path& dir);
+
+// Writes the tables into DIR and the plots into DIR/plots/ (each file atomically).
+void WriteAggregate(const std::filesystem::path& dir, const Aggregate& aggregate);
+
+// Mean, sample standard deviation and the 95 % confidence interval of the mean (Student's t,
+// n - 1 degrees of freedom; NaN when n < 2).
+struct MeanCi {
+  int n = 0;
+  double mean = 0, sd = 0, ci_low = 0, ci_high = 0, min = 0, max = 0, median = 0;
+};
+MeanCi Describe(std::vector<double> values);
+
+// The share of the total sum of squares of `values` between the groups `group` (eta squared of a
+// one-way layout, the main effect of that factor): 0..1.
+double VarianceShare(const std::vector<double>& values, const std::vector<int>& group);
+
+// A number as results.csv writes it (shortest round-trip form; "" for NaN).
+std::string CsvNumber(double value);
+
+}  // namespace mmh::sweep
