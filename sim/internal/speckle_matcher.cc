@@ -229,18 +229,19 @@ void SpeckleMatcher::MatchRow(const SpeckleScene& scene, const float* ir,
     const int span = e - s;
     // cross[(D - lo) * kSegment + (u - s)]: the window sum of ir * reference shifted by D.
     cross.assign(static_cast<size_t>(count) * kSegment, 0.0f);
+    float* __restrict sums = column.data();
     for (int d = lo; d <= hi; ++d) {
       const int width = span + 2 * rad;
-      std::fill_n(column.begin(), width, 0.0f);
+      std::fill_n(sums, width, 0.0f);
       for (int j = -rad; j <= rad; ++j) {
-        const float* a = &ir[row + static_cast<size_t>(j) * w + (s - rad)];
-        const float* b =
+        const float* __restrict a = &ir[row + static_cast<size_t>(j) * w + (s - rad)];
+        const float* __restrict b =
             &reference_[static_cast<size_t>(v + j) * columns_ + (s - rad - d - x_min_)];
-        for (int k = 0; k < width; ++k) column[k] += a[k] * b[k];
+        for (int k = 0; k < width; ++k) sums[k] += a[k] * b[k];
       }
-      float* out = &cross[static_cast<size_t>(d - lo) * kSegment];
+      float* __restrict out = &cross[static_cast<size_t>(d - lo) * kSegment];
       for (int i = 0; i <= 2 * rad; ++i) {
-        for (int k = 0; k < span; ++k) out[k] += column[k + i];
+        for (int k = 0; k < span; ++k) out[k] += sums[k + i];
       }
     }
     for (int u = s; u < e; ++u) {
