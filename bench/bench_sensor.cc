@@ -34,8 +34,9 @@ struct Setup {
   std::unique_ptr<mmh::sim::TableTopScene> scene;
   std::unique_ptr<mmh::sim::KinectSensor> sensor;
 
-  Setup() {
+  explicit Setup(bool structured_light = false) {
     config.scene.props = mmh::sim::TableProps::kCastle;
+    if (structured_light) config.sensor.mode = mmh::sim::SensorMode::kStructuredLight;
     scene = std::make_unique<mmh::sim::TableTopScene>(config, mmh::sim::LoadProxyModel("", 1.0));
     sensor = std::make_unique<mmh::sim::KinectSensor>(config.sensor, &scene->scene(),
                                                       scene->table_T_camera());
@@ -47,10 +48,14 @@ struct Setup {
   }
 };
 
-Setup& SoldierScene(int worker) {
-  static std::vector<std::unique_ptr<Setup>> setups;
-  while (static_cast<int>(setups.size()) <= worker) setups.push_back(std::make_unique<Setup>());
-  return *setups[worker];
+// structured_light: the sensor's structured-light mode (speckle image and block matching).
+Setup& SoldierScene(int worker, bool structured_light = false) {
+  static std::vector<std::unique_ptr<Setup>> setups[2];
+  auto& list = setups[structured_light ? 1 : 0];
+  while (static_cast<int>(list.size()) <= worker) {
+    list.push_back(std::make_unique<Setup>(structured_light));
+  }
+  return *list[worker];
 }
 
 void Report(benchmark::State& state, const mmh::sim::SensorTimings& t, double frames,
@@ -68,9 +73,10 @@ void Report(benchmark::State& state, const mmh::sim::SensorTimings& t, double fr
 }
 
 // One sensor, one frame of the demo walk per iteration: scene update (instances) + render.
-// Args: mode (0 incremental, 1 full), threads (1: one core; 0: all, parallel within the frame).
+// Args: mode (0 incremental, 1 full), threads (1: one core; 0: all, parallel within the frame),
+// sensor mode (0 statistical, 1 structured light).
 void BM_SensorFrame(benchmark::State& state) {
-  Setup& s = SoldierScene(0);
+  Setup& s = SoldierScene(0, state.range(2) == 1);
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
   std::unique_ptr<tbb::global_control> limit;
   if (state.range(1) > 0) {
@@ -109,17 +115,19 @@ void BM_SensorFrame(benchmark::State& state) {
   state.counters["best_noise_ms"] = 1e3 * best_steps.noise;
 }
 BENCHMARK(BM_SensorFrame)
-    ->ArgNames({"full", "threads"})
-    ->Args({0, 0})
-    ->Args({1, 0})
-    ->Args({0, 1})
-    ->Args({1, 1})
+    ->ArgNames({"full", "threads", "sl"})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({1, 1, 0})
+    ->Args({1, 0, 1})
+    ->Args({1, 1, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // Frame-level parallelism (mmh::sim::RenderFrames): one scene and sensor per worker, 120 frames
 // of the demo walk per iteration. Args: mode, workers, cores (0: all; 1: everything on one
-// thread, as one job of the pipeline renders its session).
+// thread, as one job of the pipeline renders its session), sensor mode (1: structured light).
 void BM_SensorFrames(benchmark::State& state) {
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
   std::unique_ptr<tbb::global_control> limit;
@@ -130,7 +138,7 @@ void BM_SensorFrames(benchmark::State& state) {
   const int count = 120;
   std::vector<mmh::sim::SensorWorker> workers;
   for (int w = 0; w < state.range(1); ++w) {
-    Setup& s = SoldierScene(w);
+    Setup& s = SoldierScene(w, state.range(3) == 1);
     mmh::RgbdFrame frame;
     s.sensor->Render(0, mode, &frame);  // the static cache, outside the timing
     s.sensor->ResetTimings();
@@ -149,11 +157,14 @@ void BM_SensorFrames(benchmark::State& state) {
   Report(state, mmh::sim::TotalTimings(workers), first, ProcessSeconds() - cpu0);
 }
 BENCHMARK(BM_SensorFrames)
-    ->ArgNames({"full", "workers", "cores"})
-    ->Args({0, 1, 1})
-    ->Args({0, 2, 0})
-    ->Args({1, 1, 1})
-    ->Args({1, 2, 0})
+    ->ArgNames({"full", "workers", "cores", "sl"})
+    ->Args({0, 1, 1, 0})
+    ->Args({0, 2, 0, 0})
+    ->Args({1, 1, 1, 0})
+    ->Args({1, 2, 0, 0})
+    ->Args({0, 2, 0, 1})
+    ->Args({1, 1, 1, 1})
+    ->Args({1, 2, 0, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -12,6 +12,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "sim/error_structure.h"
 #include "sim/render_session.h"
 #include "sim/sensor_check.h"
 
@@ -72,6 +73,14 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   const auto sun = ReadSunDepth(data / "SUN_depth.png");
   columns.push_back(sim::ComputeSensorStatistics(
       "SUN real", sim::DepthMetresFromUnits(sun.values, 0.001), sun.width, sun.height, options));
+  // The error structure of the Kinect v1 frames (SUN's sensor differs) beside the rendered ones.
+  const std::vector<float> tum_m = sim::DepthMetresFromUnits(tum.values, 1.0 / 5000);
+  std::vector<std::string> structure_names{"TUM real", "NYU real"};
+  std::vector<sim::ErrorStructure> structures{
+      sim::AnalyseErrorStructure(tum_m, tum.width, tum.height, options.intrinsics,
+                                 options.calibration, options.noise),
+      sim::AnalyseErrorStructure(sim::DepthMetresFromNyuRaw(nyu.values), nyu.width, nyu.height,
+                                 options.intrinsics, options.calibration, options.noise)};
 
   // Rendered frames of the table-top scene with the castle, from the config (defaults otherwise).
   Config config = LoadConfig(args.common);
@@ -83,26 +92,44 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   const auto threads = LimitThreads(args.common.threads);
   sim::TableTopScene table_top(render,
                                sim::LoadProxyModel(render.render.proxy, render.render.proxy_scale));
-  sim::KinectSensor sensor(render.sensor, &table_top.scene(), table_top.table_T_camera());
-  std::vector<float> depth;
-  int width = 0, height = 0;
+  // Both sensor modes over the same scene: the statistical model and structured light.
   std::vector<sim::SensorStatistics> rendered;
-  for (int i = 0; i < args.frames; ++i) {
-    const double t = i / render.sensor.frame_rate;
-    table_top.SetFrame(render.motion.TableTProxy(t), render.motion.SliderValue(t));
-    const RgbdFrame frame = sensor.Render(i);
-    width = frame.depth_intrinsics.width;
-    height = frame.depth_intrinsics.height;
-    sim::SensorCheckOptions frame_options = options;
-    frame_options.intrinsics = frame.depth_intrinsics;
-    frame_options.calibration = render.sensor.calibration;
-    frame_options.noise = render.sensor.axial;
-    rendered.push_back(sim::ComputeSensorStatistics(
-        "rendered", sim::DepthMetresFromUnits(frame.depth, frame.depth_scale), width, height,
-        frame_options));
+  std::vector<float> first_frames[2];
+  for (const sim::SensorMode mode : {sim::SensorMode::kStatistical,
+                                     sim::SensorMode::kStructuredLight}) {
+    sim::KinectSensorOptions sensor_options = render.sensor;
+    sensor_options.mode = mode;
+    const bool structured = mode == sim::SensorMode::kStructuredLight;
+    const std::string name = structured ? "rendered SL" : "rendered stat.";
+    sim::KinectSensor sensor(sensor_options, &table_top.scene(), table_top.table_T_camera());
+    sim::ErrorStructure mean;
+    for (int i = 0; i < args.frames; ++i) {
+      const double t = i / render.sensor.frame_rate;
+      table_top.SetFrame(render.motion.TableTProxy(t), render.motion.SliderValue(t));
+      const RgbdFrame frame = sensor.Render(i);
+      const int width = frame.depth_intrinsics.width;
+      const int height = frame.depth_intrinsics.height;
+      sim::SensorCheckOptions frame_options = options;
+      frame_options.intrinsics = frame.depth_intrinsics;
+      frame_options.calibration = render.sensor.calibration;
+      frame_options.noise = render.sensor.axial;
+      const std::vector<float> depth_m =
+          sim::DepthMetresFromUnits(frame.depth, frame.depth_scale);
+      rendered.push_back(
+          sim::ComputeSensorStatistics(name, depth_m, width, height, frame_options));
+      if (i == 0) {
+        first_frames[structured ? 1 : 0] = depth_m;
+        structure_names.push_back(name);
+        structures.push_back(sim::AnalyseErrorStructure(depth_m, width, height,
+                                                        frame.depth_intrinsics,
+                                                        render.sensor.calibration,
+                                                        render.sensor.axial));
+      }
+    }
+    columns.push_back(rendered[rendered.size() - args.frames]);
   }
-  columns.push_back(rendered.front());
-  std::cout << sim::FormatSensorTable(columns);
+  std::cout << sim::FormatSensorTable(columns) << "\n"
+            << sim::FormatRealismTable(structure_names, structures, 0, {2, 3});
   if (!args.common.out_dir.empty()) {
     const std::filesystem::path out = args.common.out_dir;
     EnsureDirectory(out);
@@ -110,8 +137,19 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
     for (const auto& c : columns) j.push_back(sim::ToJson(c));
     nlohmann::json frames = nlohmann::json::array();
     for (const auto& c : rendered) frames.push_back(sim::ToJson(c));
-    nlohmann::json result = {{"columns", j}, {"rendered_frames", frames}};
+    nlohmann::json error_structure = nlohmann::json::object();
+    for (size_t k = 0; k < structures.size(); ++k) {
+      error_structure[structure_names[k]] = sim::ToJson(structures[k]);
+    }
+    nlohmann::json result = {
+        {"columns", j}, {"rendered_frames", frames}, {"error_structure", error_structure}};
     WriteFileAtomically(out / "sensor_check.json", result.dump(2) + "\n");
+    // Real (TUM) and rendered depth side by side, for a look (the TUM frame is 640 x 480 too).
+    if (static_cast<size_t>(tum.width) * tum.height == first_frames[0].size()) {
+      WriteRgbPng(out / "sensor_check.png",
+                  sim::DepthSideBySide({&tum_m, &first_frames[0], &first_frames[1]}, tum.width,
+                                       tum.height));
+    }
     WriteFileAtomically(out / "config.resolved.json", render.ToJson().dump(2) + "\n");
     WriteFileAtomically(out / "run.json",
                         Provenance(argv, render.ToJson(), args.common.threads, {}).dump(2) + "\n");

@@ -31,6 +31,7 @@
 #include "core/rigid3.h"
 #include "sim/kinect_model.h"
 #include "sim/ray_scene.h"
+#include "sim/structured_light.h"
 
 namespace mmh::sim {
 
@@ -95,6 +96,10 @@ struct MissingDataModel {
 };
 
 struct KinectSensorOptions {
+  // Statistical (default, fast) or structured light (structured_light below; the axial, lateral
+  // and missing models then do not apply, except missing.projector_shadow and
+  // missing.ir_camera_occlusion).
+  SensorMode mode = SensorMode::kStatistical;
   // Intrinsics of the delivered images: with registered depth both depth and colour are in the
   // colour camera's image (ROS defaults 525 / 319.5 / 239.5).
   PinholeIntrinsics intrinsics;
@@ -117,11 +122,13 @@ struct KinectSensorOptions {
   LateralNoiseModel lateral;
   MissingDataModel missing;
   ColorModel color;
+  StructuredLightOptions structured_light;
   double frame_rate = 30.0;  // [Hz]
   uint64_t seed = 1;
 
   template <class V>
   void VisitFields(V& v) {
+    v("mode", mode);
     v("intrinsics", intrinsics);
     v("registered", registered);
     v("ir_intrinsics", ir_intrinsics);
@@ -135,6 +142,7 @@ struct KinectSensorOptions {
     v("lateral", lateral);
     v("missing", missing);
     v("color", color);
+    v("structured_light", structured_light);
     v("frame_rate", frame_rate);
     v("seed", seed);
   }
@@ -184,6 +192,11 @@ class KinectSensor {
   const KinectSensorOptions& options() const;
   const SensorTimings& timings() const;
   void ResetTimings();
+
+  // Structured-light mode: when kept (off by default), per depth pixel of the last rendered
+  // frame why it is missing (MissingCause::kValid where it is not); empty otherwise.
+  void KeepMissingCauses(bool keep);
+  std::span<const MissingCause> missing_causes() const;
 
   // The per-pixel noise runs in hand-written AVX-512 kernels where the CPU has them, otherwise in
   // portable ones; both give the same bytes. For tests and benchmarks: false selects the portable

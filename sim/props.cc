@@ -188,6 +188,7 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   CheckSize(prefix + ".like_box_width", like_box_width, 10.0);
   CheckSize(prefix + ".tape_width", tape_width, 0.1);
   CheckSize(prefix + ".tape_thickness", tape_thickness, 0.01);
+  materials.Validate(prefix + ".materials");
   if (!std::isfinite(like_box_center_x)) {
     ThrowBadValue(prefix + ".like_box_center_x", FormatNumber(like_box_center_x), "a finite x [m]");
   }

@@ -16,6 +16,7 @@
 #include "core/rigid3.h"
 #include "core/table_setup.h"
 #include "core/triangle_mesh.h"
+#include "sim/materials.h"
 
 namespace mmh::sim {
 
@@ -52,6 +53,8 @@ struct TableSceneOptions : TableSetup {
   bool backdrop = true;
   double backdrop_y = 0.5;  // [m], at least table_depth / 2
   TableProps props = TableProps::kNone;
+  // Materials in the IR band (the structured-light sensor mode).
+  SceneMaterials materials;
 
   template <class V>
   void VisitFields(V& v) {
@@ -70,6 +73,7 @@ struct TableSceneOptions : TableSetup {
     v("backdrop", backdrop);
     v("backdrop_y", backdrop_y);
     v("props", props);
+    v("materials", materials);
   }
   // Positive finite sizes; the play area, the Like box (with its tape) and the castle on the table;
   // the Like box apart from the play area and longer than the slider block; the wall behind the

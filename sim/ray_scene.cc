@@ -117,6 +117,7 @@ std::vector<PixelSpan> FullImageSpans(const PinholeIntrinsics& intrinsics) {
 struct RayScene::Impl {
   struct Object {
     std::string name;
+    SurfaceMaterial material;
     TriangleMesh mesh;
     bool moving = false;
     bool visible = true;
@@ -348,6 +349,13 @@ void RayScene::Commit() {
   s.CommitScene(s.full_scene);
   s.CommitScene(s.moving_scene);
   s.Check();
+}
+
+void RayScene::SetMaterial(uint32_t object, const SurfaceMaterial& material) {
+  impl_->objects.at(object).material = material;
+}
+const SurfaceMaterial& RayScene::material(uint32_t object) const {
+  return impl_->objects.at(object).material;
 }
 
 int RayScene::object_count() const { return static_cast<int>(impl_->objects.size()); }

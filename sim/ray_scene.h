@@ -11,6 +11,7 @@
 #include "core/camera.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
+#include "sim/materials.h"
 
 namespace mmh::sim {
 
@@ -86,6 +87,11 @@ class RayScene {
   // object index. All objects must be added before the first Commit.
   uint32_t AddStatic(const std::string& name, const TriangleMesh& mesh, const Rigid3& world_T_mesh);
   uint32_t AddMoving(const std::string& name, const TriangleMesh& mesh);
+
+  // The object's material in the IR band (default SurfaceMaterial{}); read by the structured-light
+  // sensor mode only.
+  void SetMaterial(uint32_t object, const SurfaceMaterial& material);
+  const SurfaceMaterial& material(uint32_t object) const;
 
   // Moves / hides a moving object; takes effect at the next Commit.
   void SetPose(uint32_t object, const Rigid3& world_T_object);

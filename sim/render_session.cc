@@ -195,7 +195,8 @@ TriangleMesh LoadProxyModel(const std::string& proxy, double scale) {
 TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model)
     : config_(config), table_T_camera_(config.camera.TableTCamera()) {
   for (const NamedMesh& part : BuildTableScene(config.scene)) {
-    scene_.AddStatic(part.name, part.mesh, Rigid3::Identity());
+    const uint32_t object = scene_.AddStatic(part.name, part.mesh, Rigid3::Identity());
+    scene_.SetMaterial(object, config.scene.materials.ForObject(part.name));
   }
   proxy_ = scene_.AddMoving("proxy", proxy_model);
   const Bounds3 bounds = ComputeBounds(proxy_model);
@@ -206,6 +207,9 @@ TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& pro
   if (depth >= 0.01 && depth <= 0.08) hand.grip_width = depth;
   if (config.render.hand) hand_ = scene_.AddMoving("hand", BuildHandAndForearm(hand));
   if (config.render.slider) slider_ = scene_.AddMoving("slider", BuildSliderBlock());
+  for (int o = 0; o < scene_.object_count(); ++o) {
+    if (scene_.is_moving(o)) scene_.SetMaterial(o, config.scene.materials.ForObject(scene_.object_name(o)));
+  }
   SetFrame(Rigid3::Identity(), 0.0);  // a valid, committed scene from the start
 }
 

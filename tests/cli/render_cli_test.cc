@@ -135,10 +135,12 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   }
   const auto r = RunMmh("sensor-check --frames 1 --out " + dir_.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const char* column : {"TUM real", "NYU real", "SUN real", "rendered"}) {
+  for (const char* column : {"TUM real", "NYU real", "SUN real", "rendered stat.", "rendered SL",
+                             "missing, shadow [%]", "correlation length [px]", "goal"}) {
     EXPECT_THAT(r.output, HasSubstr(column));
   }
   EXPECT_TRUE(fs::exists(dir_ / "sensor_check.json"));
+  EXPECT_TRUE(fs::exists(dir_ / "sensor_check.png"));
 }
 
 }  // namespace

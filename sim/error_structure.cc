@@ -1,0 +1,306 @@
+#include "sim/error_structure.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "core/error.h"
+
+namespace mmh::sim {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return kNaN;
+  const size_t middle = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + middle, values.end());
+  return values[middle];
+}
+
+bool Valid(float z) { return std::isfinite(z) && z > 0; }
+
+}  // namespace
+
+void ErrorStructureOptions::Validate(const std::string& prefix) const {
+  if (!(step_fraction > 0 && step_fraction < 1)) {
+    ThrowBadValue(prefix + ".step_fraction", FormatNumber(step_fraction), "a fraction in (0, 1)");
+  }
+  RequirePositive(far_m, prefix + ".far_m", "m");
+  if (patch_size < 5 || patch_size % 2 == 0 || patch_size > 63) {
+    ThrowBadValue(prefix + ".patch_size", std::to_string(patch_size), "an odd size in [5, 63] px");
+  }
+  if (!(max_incidence_deg > 0 && max_incidence_deg < 90)) {
+    ThrowBadValue(prefix + ".max_incidence_deg", FormatNumber(max_incidence_deg),
+                  "an angle in (0, 90) degrees");
+  }
+  RequirePositive(outlier_factor, prefix + ".outlier_factor");
+  if (!(min_depth_m >= 0 && max_depth_m > min_depth_m)) {
+    ThrowBadValue(prefix + ".max_depth_m", FormatNumber(max_depth_m),
+                  "a depth above min_depth_m (" + FormatNumber(min_depth_m) + " m)");
+  }
+}
+
+ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int width, int height,
+                                     const PinholeIntrinsics& intrinsics,
+                                     const KinectCalibration& calibration,
+                                     const AxialNoiseModel& noise,
+                                     const ErrorStructureOptions& options) {
+  options.Validate("error_structure");
+  if (width < 1 || height < 1 || depth_m.size() != static_cast<size_t>(width) * height) {
+    ThrowBadValue("depth", std::to_string(depth_m.size()) + " pixels",
+                  std::to_string(width) + "x" + std::to_string(height) + " pixels");
+  }
+  ErrorStructure s;
+  const double pixels = static_cast<double>(width) * height;
+  std::vector<double> shadow_runs, edge_runs;
+  for (int v = 0; v < height; ++v) {
+    const float* row = &depth_m[static_cast<size_t>(v) * width];
+    for (int u = 0; u < width;) {
+      if (Valid(row[u])) {
+        ++u;
+        continue;
+      }
+      const int first = u;
+      while (u < width && !Valid(row[u])) ++u;
+      const double length = u - first;
+      if (first == 0 || u == width) {
+        s.missing_border += length;
+        continue;
+      }
+      const double left = row[first - 1], right = row[u];
+      const double nearer = std::min(left, right);
+      if (left - right > options.step_fraction * nearer) {
+        s.missing_shadow += length;
+        shadow_runs.push_back(length);
+      } else if (right - left > options.step_fraction * nearer) {
+        s.missing_edge += length;
+        edge_runs.push_back(length);
+      } else if (nearer > options.far_m) {
+        s.missing_range += length;
+      } else {
+        s.missing_low_signal += length;
+      }
+    }
+  }
+  s.missing_border /= pixels;
+  s.missing_shadow /= pixels;
+  s.missing_edge /= pixels;
+  s.missing_range /= pixels;
+  s.missing_low_signal /= pixels;
+  s.shadow_band_px = Median(shadow_runs);
+  s.edge_band_px = Median(edge_runs);
+
+  // Planar patches: residuals of a least-squares plane z = a u + b v + c.
+  const int n = options.patch_size;
+  const int lags = n / 2;
+  const double max_tan = std::tan(options.max_incidence_deg * std::numbers::pi / 180.0);
+  Eigen::MatrixXd design(n * n, 3);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) design.row(j * n + i) << i - n / 2, j - n / 2, 1.0;
+  }
+  const Eigen::MatrixXd solve = (design.transpose() * design).inverse() * design.transpose();
+  struct Patch {
+    Eigen::VectorXd residual;
+    double sigma, model;
+  };
+  std::vector<Patch> patches;
+  for (int v0 = 0; v0 + n <= height; v0 += n) {
+    for (int u0 = 0; u0 + n <= width; u0 += n) {
+      Eigen::VectorXd z(n * n);
+      bool full = true;
+      for (int j = 0; j < n && full; ++j) {
+        for (int i = 0; i < n; ++i) {
+          const float d = depth_m[static_cast<size_t>(v0 + j) * width + u0 + i];
+          if (!Valid(d) || d < options.min_depth_m || d > options.max_depth_m) {
+            full = false;
+            break;
+          }
+          z[j * n + i] = d;
+        }
+      }
+      if (!full) continue;
+      const Eigen::Vector3d plane = solve * z;
+      const double zc = plane[2];
+      // Incidence: the plane's normal in the camera frame from its depth gradient (per pixel,
+      // dz/du = a, dz/dv = b; a pixel spans z / f metres).
+      const double gx = plane[0] * intrinsics.fx / zc, gy = plane[1] * intrinsics.fy / zc;
+      if (std::hypot(gx, gy) > max_tan) continue;
+      Patch p;
+      p.residual = z - design * plane;
+      p.sigma = std::sqrt(p.residual.squaredNorm() / (n * n - 3));
+      const double theta = std::atan(std::hypot(gx, gy));
+      const double step = LatticeStep(zc, calibration);
+      const double sigma_z = noise.Sigma(zc, theta);
+      p.model = std::sqrt(sigma_z * sigma_z + step * step / 12.0);
+      patches.push_back(std::move(p));
+    }
+  }
+  std::vector<double> sigmas;
+  for (const Patch& p : patches) sigmas.push_back(p.sigma);
+  const double typical = Median(sigmas);
+  std::vector<double> numerator(lags + 1, 0.0), ratios;
+  double energy = 0;
+  for (const Patch& p : patches) {
+    if (!(p.sigma <= options.outlier_factor * typical)) continue;
+    ++s.patches;
+    ratios.push_back(p.sigma / p.model);
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const double r = p.residual[j * n + i];
+        energy += 2 * r * r;
+        for (int k = 1; k <= lags; ++k) {
+          if (i + k < n) numerator[k] += r * p.residual[j * n + i + k];
+          if (j + k < n) numerator[k] += r * p.residual[(j + k) * n + i];
+        }
+      }
+    }
+  }
+  s.noise_over_model = Median(ratios);
+  s.autocorrelation.assign(lags, kNaN);
+  if (energy > 0) {
+    for (int k = 1; k <= lags; ++k) {
+      // Pairs at lag k are fewer than squares: normalise per pair count (n - k of n per line).
+      s.autocorrelation[k - 1] = numerator[k] / energy * n / (n - k);
+    }
+  }
+  const double target = std::exp(-1.0);
+  s.correlation_length_px = kNaN;
+  if (!s.autocorrelation.empty() && std::isfinite(s.autocorrelation[0])) {
+    double previous = 1.0;
+    s.correlation_length_px = lags;  // not reached within the patch
+    for (int k = 1; k <= lags; ++k) {
+      const double rho = s.autocorrelation[k - 1];
+      if (rho <= target) {
+        s.correlation_length_px = (k - 1) + (previous - target) / (previous - rho);
+        break;
+      }
+      previous = rho;
+    }
+  }
+  return s;
+}
+
+nlohmann::json ToJson(const ErrorStructure& s) {
+  return {{"missing_by_cause",
+           {{"border", s.missing_border},
+            {"shadow", s.missing_shadow},
+            {"edge", s.missing_edge},
+            {"range", s.missing_range},
+            {"low_signal", s.missing_low_signal}}},
+          {"shadow_band_px", s.shadow_band_px},
+          {"edge_band_px", s.edge_band_px},
+          {"patches", s.patches},
+          {"noise_over_model", s.noise_over_model},
+          {"autocorrelation", s.autocorrelation},
+          {"correlation_length_px", s.correlation_length_px}};
+}
+
+std::string FormatRealismTable(const std::vector<std::string>& names,
+                               const std::vector<ErrorStructure>& structures, size_t reference,
+                               const std::vector<size_t>& rendered) {
+  struct Statistic {
+    std::string label;
+    double (*value)(const ErrorStructure&);
+  };
+  const Statistic statistics[] = {
+      {"missing, all causes [%]",
+       [](const ErrorStructure& s) {
+         return 100 * (s.missing_border + s.missing_shadow + s.missing_edge + s.missing_range +
+                       s.missing_low_signal);
+       }},
+      {"missing, image border [%]", [](const ErrorStructure& s) { return 100 * s.missing_border; }},
+      {"missing, shadow [%]", [](const ErrorStructure& s) { return 100 * s.missing_shadow; }},
+      {"missing, edge [%]", [](const ErrorStructure& s) { return 100 * s.missing_edge; }},
+      {"missing, range [%]", [](const ErrorStructure& s) { return 100 * s.missing_range; }},
+      {"missing, low signal [%]",
+       [](const ErrorStructure& s) { return 100 * s.missing_low_signal; }},
+      {"shadow band width [px]", [](const ErrorStructure& s) { return s.shadow_band_px; }},
+      {"edge band width [px]", [](const ErrorStructure& s) { return s.edge_band_px; }},
+      {"small-patch noise / model", [](const ErrorStructure& s) { return s.noise_over_model; }},
+      {"residual autocorrelation lag 1",
+       [](const ErrorStructure& s) {
+         return s.autocorrelation.empty() ? kNaN : s.autocorrelation[0];
+       }},
+      {"residual autocorrelation lag 2",
+       [](const ErrorStructure& s) {
+         return s.autocorrelation.size() < 2 ? kNaN : s.autocorrelation[1];
+       }},
+      {"correlation length [px]", [](const ErrorStructure& s) { return s.correlation_length_px; }},
+  };
+  auto cell = [](double v) {
+    if (!std::isfinite(v)) return std::string("-");
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.2f", v);
+    return std::string(buffer);
+  };
+  std::vector<std::string> header = names;
+  for (size_t r : rendered) header.push_back(names[r] + " / " + names[reference]);
+  header.push_back("goal");
+  std::vector<std::vector<std::string>> rows;
+  for (const Statistic& statistic : statistics) {
+    std::vector<std::string> row{statistic.label};
+    for (const ErrorStructure& s : structures) row.push_back(cell(statistic.value(s)));
+    const double real = statistic.value(structures[reference]);
+    for (size_t r : rendered) {
+      const double value = statistic.value(structures[r]);
+      row.push_back(real != 0 ? cell(value / real) : std::string("-"));
+    }
+    row.push_back("0.80-1.20");
+    rows.push_back(std::move(row));
+  }
+  std::vector<size_t> widths(header.size() + 1, 0);
+  for (const auto& row : rows) {
+    for (size_t c = 0; c < row.size(); ++c) widths[c] = std::max(widths[c], row[c].size());
+  }
+  for (size_t c = 0; c < header.size(); ++c) widths[c + 1] = std::max(widths[c + 1], header[c].size());
+  auto line = [&](const std::vector<std::string>& cells) {
+    std::string text = cells[0] + std::string(widths[0] - cells[0].size(), ' ');
+    for (size_t c = 1; c < cells.size(); ++c) {
+      text += "  " + std::string(widths[c] - cells[c].size(), ' ') + cells[c];
+    }
+    return text + "\n";
+  };
+  std::vector<std::string> first{""};
+  first.insert(first.end(), header.begin(), header.end());
+  std::string table = line(first);
+  for (const auto& row : rows) table += line(row);
+  return table;
+}
+
+RgbImage DepthSideBySide(const std::vector<const std::vector<float>*>& depths_m, int width,
+                         int height) {
+  constexpr int kGap = 8;
+  RgbImage image;
+  const int count = static_cast<int>(depths_m.size());
+  image.width = count * width + (count - 1) * kGap;
+  image.height = height;
+  image.rgb.assign(3 * static_cast<size_t>(image.width) * height, 255);
+  for (int k = 0; k < count; ++k) {
+    const std::vector<float>& depth = *depths_m[k];
+    if (depth.size() != static_cast<size_t>(width) * height) {
+      ThrowBadValue("depth image " + std::to_string(k), std::to_string(depth.size()) + " pixels",
+                    std::to_string(width) + "x" + std::to_string(height) + " pixels");
+    }
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const float z = depth[static_cast<size_t>(v) * width + u];
+        uint8_t* out = &image.rgb[3 * (static_cast<size_t>(v) * image.width + k * (width + kGap) + u)];
+        if (!Valid(z)) {
+          out[0] = 200;
+          out[1] = out[2] = 0;
+          continue;
+        }
+        // Inverse depth: equal steps of disparity look alike at every range.
+        const double t = std::clamp((1.0 / z - 0.25) / (2.0 - 0.25), 0.0, 1.0);
+        out[0] = out[1] = out[2] = static_cast<uint8_t>(std::lround(30 + 225 * t));
+      }
+    }
+  }
+  return image;
+}
+
+}  // namespace mmh::sim

@@ -1,0 +1,83 @@
+// The structure of a depth sensor's errors, for comparing real frames with rendered ones
+// (`mmh sensor-check`): why pixels are missing, how wide the missing bands beside depth edges
+// are, and how depth residuals on planes correlate in space (block matching correlates them over
+// its window; per-pixel noise does not).
+//
+// Missing pixels by cause, from the depth image alone (real frames carry no labels). Each
+// horizontal run of missing pixels in a row is classified by its valid neighbours left (z_l) and
+// right (z_r):
+//  - border: it touches the image's left or right side;
+//  - shadow: z_r nearer than z_l by more than step_fraction (the projector sits at +x of the IR
+//    camera, so its shadow falls left of near edges);
+//  - edge: z_l nearer than z_r by more than step_fraction (the far side of a near edge: the IR
+//    camera's occlusion and the correlation window straddling two surfaces);
+//  - range: both neighbours beyond far_m (the far end of the sensor's range);
+//  - low signal: the rest (dark, shiny, grazing, thin: the pattern did not come back).
+// Shadow and edge runs give the band widths (median run length beside a depth step).
+//
+// Residual autocorrelation. The image is tiled with patch_size windows; a fully valid window
+// seen at no more than max_incidence_deg gets a least-squares plane; windows whose residual sigma
+// exceeds outlier_factor times the median of all windows (edges inside) are left out. Pooled
+// over windows, rho(k) = sum r(u, v) r(u + k, v) / sum r(u, v)^2 (horizontal and vertical lags
+// k = 1 .. patch_size / 2); the correlation length is the lag where rho falls to 1/e (linear
+// between lags, starting from rho(0) = 1).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/image_io.h"
+#include "sim/kinect_model.h"
+
+namespace mmh::sim {
+
+struct ErrorStructureOptions {
+  double step_fraction = 0.05;  // relative depth step that makes a run a shadow or edge
+  double far_m = 3.5;           // both neighbours beyond: range
+  int patch_size = 9;           // odd
+  double max_incidence_deg = 60.0;
+  double outlier_factor = 3.0;
+  double min_depth_m = 0.4;     // patches outside [min_depth_m, max_depth_m] are left out
+  double max_depth_m = 4.0;
+
+  void Validate(const std::string& prefix) const;
+};
+
+struct ErrorStructure {
+  // Shares of all pixels.
+  double missing_border = 0, missing_shadow = 0, missing_edge = 0, missing_range = 0,
+         missing_low_signal = 0;
+  double shadow_band_px = 0;  // median length of shadow runs (NaN: none)
+  double edge_band_px = 0;    // median length of edge runs (NaN: none)
+  int patches = 0;
+  // Median over patches of residual sigma / sqrt(sigma_z^2 + step^2 / 12) (AxialNoiseModel,
+  // LatticeStep): the small-patch noise relative to the per-pixel model.
+  double noise_over_model = 0;
+  std::vector<double> autocorrelation;  // rho(1) .. rho(patch_size / 2)
+  double correlation_length_px = 0;
+};
+
+// depth_m: width x height row-major [m], 0 = missing; intrinsics for incidence angles.
+ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int width, int height,
+                                     const PinholeIntrinsics& intrinsics,
+                                     const KinectCalibration& calibration,
+                                     const AxialNoiseModel& noise,
+                                     const ErrorStructureOptions& options = {});
+
+nlohmann::json ToJson(const ErrorStructure& structure);
+
+// Real against rendered: one row per statistic, a column per named structure, then the ratio of
+// each rendered column (indices `rendered`) to the real one (index `reference`), and the goal
+// (within 20 % of the real frame's).
+std::string FormatRealismTable(const std::vector<std::string>& names,
+                               const std::vector<ErrorStructure>& structures, size_t reference,
+                               const std::vector<size_t>& rendered);
+
+// Depth images side by side as one RGB image for a human to compare (grey by inverse depth
+// over [0.5, 4] m, near bright; missing pixels red); every image width x height.
+RgbImage DepthSideBySide(const std::vector<const std::vector<float>*>& depths_m, int width,
+                         int height);
+
+}  // namespace mmh::sim

@@ -1,0 +1,34 @@
+#include "sim/materials.h"
+
+#include "core/error.h"
+
+namespace mmh::sim {
+
+void SurfaceMaterial::Validate(const std::string& prefix) const {
+  RequireProbability(ir_albedo, prefix + ".ir_albedo");
+  RequireProbability(specularity, prefix + ".specularity");
+}
+
+void SceneMaterials::Validate(const std::string& prefix) const {
+  table.Validate(prefix + ".table");
+  floor.Validate(prefix + ".floor");
+  tape.Validate(prefix + ".tape");
+  backdrop.Validate(prefix + ".backdrop");
+  props.Validate(prefix + ".props");
+  proxy.Validate(prefix + ".proxy");
+  skin.Validate(prefix + ".skin");
+  slider.Validate(prefix + ".slider");
+}
+
+const SurfaceMaterial& SceneMaterials::ForObject(const std::string& name) const {
+  if (name == "table") return table;
+  if (name == "floor") return floor;
+  if (name == "play_area_tape" || name == "like_box_tape") return tape;
+  if (name == "backdrop") return backdrop;
+  if (name == "proxy") return proxy;
+  if (name == "hand") return skin;
+  if (name == "slider") return slider;
+  return props;
+}
+
+}  // namespace mmh::sim

@@ -1,0 +1,92 @@
+// The structured-light mode of the synthetic Kinect (docs/sensor.md, "Structured light"): the
+// projector's speckle pattern on the scene, the IR image it makes, and disparity by correlating
+// windows of that image with the reference pattern, as the device computes it. Edge fattening,
+// patchy errors and holes on dark, specular, grazing, thin and far surfaces follow from the
+// image and the matching, not from per-effect rules.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+
+namespace mmh::sim {
+
+// How the sensor turns geometry into depth (config `sensor.mode`).
+enum class SensorMode {
+  // The per-pixel model of docs/sensor.md (Nguyen et al. 2012 noise, edge and grazing rules):
+  // fast, the default.
+  kStatistical,
+  // Speckle pattern, IR image and block matching (StructuredLightOptions).
+  kStructuredLight,
+};
+std::span<const std::pair<SensorMode, const char*>> EnumNames(SensorMode);
+
+// Why a pixel has no depth in the structured-light mode (KinectSensor::missing_causes).
+enum class MissingCause : uint8_t {
+  kValid = 0,
+  kBorder,        // the window leaves the image
+  kNothing,       // nothing hit (beyond everything)
+  kShadow,        // hidden from the projector (IR shadow) or from the IR camera
+  kLowSignal,     // window contrast below min_contrast
+  kNoMatch,       // correlation below min_correlation, or the peak at the search range's end
+  kAmbiguous,     // a second peak nearly as good
+  kRange,         // outside the lattice or [min_depth, max_depth]
+};
+
+struct StructuredLightOptions {
+  // The speckle pattern, fixed per device: dots at random positions (density per IR pixel; the
+  // Kinect v1 projects about 34 000 dots, 0.11 per pixel of its 640 x 480 image), each a Gaussian
+  // of dot_sigma_px (optics and pixel blur) with a brightness uniform in [0.5, 1].
+  double dot_density = 0.11;
+  double dot_sigma_px = 0.6;
+  uint64_t pattern_seed = 20100604;
+  // The IR image, full scale 1: a dot of brightness 1 on a white Lambertian surface facing the
+  // camera at 1 m peaks at projector_power (fall-off 1 / z^2), ambient IR light reflected by the
+  // surface adds ambient * albedo; sensor noise sigma^2 = read_noise^2 + shot_gain * value;
+  // values clip at full scale and are quantised to adc_bits.
+  double projector_power = 0.6;
+  double ambient = 0.02;
+  double read_noise = 0.004;
+  double shot_gain = 0.002;
+  int adc_bits = 10;
+  // Glare, the mirror lobe of SurfaceMaterial::specularity: specular_gain cos^n(theta), n =
+  // specular_exponent (whole), without the dots (a mirror shows the projector's aperture, not
+  // the pattern on its surface): near normal incidence it floods the window, the match fails.
+  double specular_exponent = 40.0;
+  double specular_gain = 8.0;
+  // Block matching: window of window_px square (odd) against the reference pattern, at integer
+  // disparities within search_px of the rendered disparities under the window (the device
+  // searches its whole range; the truth is known here, so only the candidates that can win are
+  // scored), refined by a parabola through the peak and its neighbours, reported on the
+  // 1/subpixel_steps lattice. Rejected: normalised correlation below min_correlation, window
+  // contrast (standard deviation) below min_contrast (low signal), a second peak at least two
+  // pixels away scoring above ambiguity_ratio times the best, or a peak on the search range's end.
+  int window_px = 9;
+  int search_px = 2;
+  double min_correlation = 0.5;
+  double min_contrast = 0.005;
+  double ambiguity_ratio = 0.95;
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("dot_density", dot_density);
+    v("dot_sigma_px", dot_sigma_px);
+    v("pattern_seed", pattern_seed);
+    v("projector_power", projector_power);
+    v("ambient", ambient);
+    v("read_noise", read_noise);
+    v("shot_gain", shot_gain);
+    v("adc_bits", adc_bits);
+    v("specular_exponent", specular_exponent);
+    v("specular_gain", specular_gain);
+    v("window_px", window_px);
+    v("search_px", search_px);
+    v("min_correlation", min_correlation);
+    v("min_contrast", min_contrast);
+    v("ambiguity_ratio", ambiguity_ratio);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+}  // namespace mmh::sim

@@ -1,0 +1,130 @@
+// The error-structure statistics against images built with known missing runs and known
+// residual correlation.
+#include "sim/error_structure.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "core/error.h"
+
+namespace mmh::sim {
+namespace {
+
+constexpr int kWidth = 320, kHeight = 240;
+
+TEST(ErrorStructure, MissingRunsAreClassifiedByTheirNeighbours) {
+  // A wall at 2 m; in each row a near board (1 m) over columns [100, 160) with a 6-px hole left
+  // of it (shadow: nearer on the right) and a 3-px hole right of it (edge); a 10-px hole inside
+  // the wall (low signal); a hole at the left border; rows 200+ at 3.8 m with a hole (range).
+  std::vector<float> depth(kWidth * kHeight, 2.0f);
+  for (int v = 0; v < kHeight; ++v) {
+    float* row = &depth[v * kWidth];
+    if (v >= 200) {
+      for (int u = 0; u < kWidth; ++u) row[u] = 3.8f;
+      for (int u = 50; u < 54; ++u) row[u] = 0;
+      continue;
+    }
+    for (int u = 100; u < 160; ++u) row[u] = 1.0f;
+    for (int u = 94; u < 100; ++u) row[u] = 0;
+    for (int u = 160; u < 163; ++u) row[u] = 0;
+    for (int u = 250; u < 260; ++u) row[u] = 0;
+    for (int u = 0; u < 2; ++u) row[u] = 0;
+  }
+  const ErrorStructure s = AnalyseErrorStructure(depth, kWidth, kHeight, PinholeIntrinsics(),
+                                                 KinectCalibration(), AxialNoiseModel());
+  const double pixels = kWidth * kHeight;
+  EXPECT_DOUBLE_EQ(s.missing_shadow, 200 * 6 / pixels);
+  EXPECT_DOUBLE_EQ(s.missing_edge, 200 * 3 / pixels);
+  EXPECT_DOUBLE_EQ(s.missing_low_signal, 200 * 10 / pixels);
+  EXPECT_DOUBLE_EQ(s.missing_border, 200 * 2 / pixels);
+  EXPECT_DOUBLE_EQ(s.missing_range, 40 * 4 / pixels);
+  EXPECT_DOUBLE_EQ(s.shadow_band_px, 6);
+  EXPECT_DOUBLE_EQ(s.edge_band_px, 3);
+}
+
+// A tilted plane plus noise: white, or averaged over 3 x 3 pixels (neighbours share 6 of 9
+// terms horizontally and vertically: rho(1) = 2/3, rho(2) = 1/3, rho(3) = 0).
+std::vector<float> NoisyPlane(bool smoothed, double sigma) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal(0.0, sigma);
+  std::vector<double> white((kWidth + 2) * (kHeight + 2));
+  for (double& x : white) x = normal(rng);
+  std::vector<float> depth(kWidth * kHeight);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      double e = white[(v + 1) * (kWidth + 2) + u + 1];
+      if (smoothed) {
+        e = 0;
+        for (int j = 0; j < 3; ++j) {
+          for (int i = 0; i < 3; ++i) e += white[(v + j) * (kWidth + 2) + u + i];
+        }
+        e /= 3.0;  // 9 terms of variance sigma^2, divided by 3: variance sigma^2
+      }
+      depth[v * kWidth + u] = static_cast<float>(1.5 + 0.0004 * u - 0.0003 * v + e);
+    }
+  }
+  return depth;
+}
+
+TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
+  const ErrorStructure white =
+      AnalyseErrorStructure(NoisyPlane(false, 0.003), kWidth, kHeight, PinholeIntrinsics(),
+                            KinectCalibration(), AxialNoiseModel());
+  const ErrorStructure smooth =
+      AnalyseErrorStructure(NoisyPlane(true, 0.003), kWidth, kHeight, PinholeIntrinsics(),
+                            KinectCalibration(), AxialNoiseModel());
+  ASSERT_EQ(white.autocorrelation.size(), 4u);
+  EXPECT_GT(white.patches, 800);
+  // The plane fit removes 3 of 81 degrees of freedom: a small negative bias.
+  EXPECT_NEAR(white.autocorrelation[0], 0.0, 0.05);
+  EXPECT_LT(white.correlation_length_px, 1.0);
+  // The oracle for the smoothed noise: the expected residual covariance of a 9 x 9 window,
+  // (I - H) S (I - H) with H the plane fit's hat matrix and S the 3 x 3 box's covariance
+  // (overlap of the two pixels' boxes / 9), pooled as the estimator pools it.
+  constexpr int n = 9;
+  Eigen::MatrixXd design(n * n, 3), cov(n * n, n * n);
+  for (int a = 0; a < n * n; ++a) {
+    design.row(a) << a % n, a / n, 1.0;
+    for (int b = 0; b < n * n; ++b) {
+      const int du = std::abs(a % n - b % n), dv = std::abs(a / n - b / n);
+      cov(a, b) = std::max(0, 3 - du) * std::max(0, 3 - dv) / 9.0;
+    }
+  }
+  const Eigen::MatrixXd residual_maker =
+      Eigen::MatrixXd::Identity(n * n, n * n) -
+      design * (design.transpose() * design).inverse() * design.transpose();
+  const Eigen::MatrixXd r = residual_maker * cov * residual_maker;
+  for (int k = 1; k <= 3; ++k) {
+    double pairs = 0;
+    for (int a = 0; a < n * n; ++a) {
+      if (a % n + k < n) pairs += r(a, a + k);
+      if (a / n + k < n) pairs += r(a, a + k * n);
+    }
+    const double expected = pairs / (2 * r.trace()) * n / (n - k);
+    EXPECT_NEAR(smooth.autocorrelation[k - 1], expected, 0.03) << k;
+  }
+  // Without the fit: 2/3, 1/3, 0; the fit lowers them (about 0.6, 0.25, -0.05).
+  EXPECT_GT(smooth.correlation_length_px, 1.2);
+  EXPECT_LT(smooth.correlation_length_px, 2.0);
+  // Small-patch noise against the per-pixel model at 1.5 m (sigma_z 3.5 mm, step 6.5 mm):
+  // sqrt(3.5^2 + 6.5^2 / 12) = 4.0 mm, so 3 mm of noise is about 0.75 of it.
+  EXPECT_NEAR(white.noise_over_model, 0.75, 0.08);
+}
+
+TEST(ErrorStructure, BadInputNamesTheField) {
+  ErrorStructureOptions options;
+  options.patch_size = 8;
+  EXPECT_THROW(options.Validate("x"), InputError);
+  EXPECT_THROW(AnalyseErrorStructure(std::vector<float>(10), kWidth, kHeight, PinholeIntrinsics(),
+                                     KinectCalibration(), AxialNoiseModel()),
+               InputError);
+}
+
+}  // namespace
+}  // namespace mmh::sim

@@ -1,0 +1,201 @@
+// The structured-light sensor mode against analytic geometry: planes at known depths, the
+// materials that make the pattern vanish, the IR shadow, the block-matching signature (spatially
+// correlated errors), determinism.
+#include "sim/structured_light.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <vector>
+
+#include "core/error.h"
+#include "tests/sim/test_meshes.h"
+#include "sim/kinect_sensor.h"
+
+namespace mmh::sim {
+namespace {
+
+using ::testing::HasSubstr;
+
+using test_meshes::Quad;
+
+// A wall facing the camera (camera at the origin looking along +z) at depth z.
+Rigid3 WallAt(double z) {
+  return Rigid3(Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(),
+                                                   -Eigen::Vector3d::UnitZ()),
+                Eigen::Vector3d(0, 0, z));
+}
+
+KinectSensorOptions StructuredLight() {
+  KinectSensorOptions options;
+  options.mode = SensorMode::kStructuredLight;
+  return options;
+}
+
+struct Stats {
+  int valid = 0, missing = 0;
+  double mean_error = 0, rms_error = 0;
+};
+// Over the image's centre (a 400 x 300 window), against the true depth z.
+Stats CentreStats(const RgbdFrame& frame, double z) {
+  Stats s;
+  const int w = frame.depth_intrinsics.width;
+  for (int v = 90; v < 390; ++v) {
+    for (int u = 120; u < 520; ++u) {
+      const uint16_t d = frame.depth[v * w + u];
+      if (d == 0) {
+        ++s.missing;
+        continue;
+      }
+      const double e = d * frame.depth_scale - z;
+      ++s.valid;
+      s.mean_error += e;
+      s.rms_error += e * e;
+    }
+  }
+  if (s.valid > 0) {
+    s.mean_error /= s.valid;
+    s.rms_error = std::sqrt(s.rms_error / s.valid);
+  }
+  return s;
+}
+
+RgbdFrame RenderWall(double z, const SurfaceMaterial& material, const KinectSensorOptions& options,
+                     int index = 0) {
+  RayScene scene;
+  const uint32_t wall = scene.AddStatic("wall", Quad(20, 20), WallAt(z));
+  scene.SetMaterial(wall, material);
+  scene.Commit();
+  KinectSensor sensor(options, &scene, Rigid3::Identity());
+  return sensor.Render(index, RenderMode::kFull);
+}
+
+TEST(StructuredLight, WallsAtOneToThreeMetresMatchTheirDepthOnTheLattice) {
+  const KinectCalibration calibration;
+  for (const double z : {0.8, 1.2, 2.0, 3.0}) {
+    const RgbdFrame frame = RenderWall(z, SurfaceMaterial{0.7, 0.0}, StructuredLight());
+    const Stats s = CentreStats(frame, z);
+    const double step = LatticeStep(z, calibration);
+    SCOPED_TRACE(z);
+    EXPECT_GT(s.valid, 0.97 * (s.valid + s.missing));
+    // Sub-pixel matching: biased by less than one lattice step (1/8 px of disparity; a
+    // fronto-parallel wall has one disparity fraction everywhere, so the parabola's pull towards
+    // whole pixels, "pixel locking", does not average out: 0.51 steps at 0.8 m, where d = 54.4
+    // px), spread of a few steps (Kinect v1 at 1-3 m: 1-2 steps, Khoshelham and Elberink 2012).
+    EXPECT_LT(std::abs(s.mean_error), step) << s.mean_error << " " << s.rms_error;
+    EXPECT_LT(s.rms_error, 3.0 * step) << s.mean_error << " " << s.rms_error;
+    EXPECT_GT(s.rms_error, 0.1 * step) << s.mean_error << " " << s.rms_error;
+    // Every depth on the lattice.
+    for (uint16_t d : frame.depth) {
+      if (d == 0) continue;
+      const int raw = RawFromDepth(d * frame.depth_scale, calibration);
+      ASSERT_NEAR(d * frame.depth_scale, DepthFromRaw(raw, calibration), 1e-4);
+    }
+  }
+}
+
+TEST(StructuredLight, DarkFarAndMirrorSurfacesLoseThePattern) {
+  const KinectSensorOptions options = StructuredLight();
+  // Black matte at 3.5 m: below the sensor noise.
+  EXPECT_GT(CentreStats(RenderWall(3.5, SurfaceMaterial{0.02, 0.0}, options), 3.5).missing,
+            0.9 * 400 * 300);
+  // The same grey wall returns less and less with distance.
+  const double near = CentreStats(RenderWall(1.5, SurfaceMaterial{0.15, 0.0}, options), 1.5).missing;
+  const double far = CentreStats(RenderWall(3.8, SurfaceMaterial{0.15, 0.0}, options), 3.8).missing;
+  EXPECT_LT(near, 0.05 * 400 * 300);
+  EXPECT_GT(far, near + 0.2 * 400 * 300);
+  // A mirror facing the camera at 1 m saturates the IR image where it returns the projector.
+  EXPECT_GT(CentreStats(RenderWall(1.0, SurfaceMaterial{0.5, 1.0}, options), 1.0).missing,
+            0.5 * 400 * 300);
+}
+
+TEST(StructuredLight, ErrorsAreSpatiallyCorrelatedUnlikeTheStatisticalModel) {
+  // Residual correlation of horizontal neighbours on a wall at 2 m: block matching shares most
+  // of the window between neighbours (correlated), per-pixel noise does not.
+  auto neighbour_correlation = [](const RgbdFrame& frame, double z) {
+    const int w = frame.depth_intrinsics.width;
+    double sxy = 0, sxx = 0;
+    for (int v = 90; v < 390; ++v) {
+      for (int u = 120; u < 520; ++u) {
+        const uint16_t a = frame.depth[v * w + u], b = frame.depth[v * w + u + 1];
+        if (a == 0 || b == 0) continue;
+        const double ea = a * frame.depth_scale - z, eb = b * frame.depth_scale - z;
+        sxy += ea * eb;
+        sxx += 0.5 * (ea * ea + eb * eb);
+      }
+    }
+    return sxy / sxx;
+  };
+  const double structured =
+      neighbour_correlation(RenderWall(2.0, SurfaceMaterial{0.7, 0.0}, StructuredLight()), 2.0);
+  const double statistical =
+      neighbour_correlation(RenderWall(2.0, SurfaceMaterial{0.7, 0.0}, KinectSensorOptions()), 2.0);
+  EXPECT_GT(structured, 0.5);
+  EXPECT_LT(statistical, 0.2);
+}
+
+TEST(StructuredLight, ShadowOfANearBoxFallsOnTheProjectorSideAndIsMissing) {
+  // A 20 cm board at 1 m in front of a wall at 2 m: the projector (at +x) cannot light a band
+  // left of the board of width f_x s (1/z_near - 1/z_far) (s = 5 cm from the colour camera).
+  RayScene scene;
+  const uint32_t wall = scene.AddStatic("wall", Quad(20, 20), WallAt(2.0));
+  const uint32_t board = scene.AddStatic("board", Quad(0.2, 0.2), WallAt(1.0));
+  scene.SetMaterial(wall, SurfaceMaterial{0.7, 0.0});
+  scene.SetMaterial(board, SurfaceMaterial{0.7, 0.0});
+  scene.Commit();
+  KinectSensor sensor(StructuredLight(), &scene, Rigid3::Identity());
+  sensor.KeepMissingCauses(true);
+  const RgbdFrame frame = sensor.Render(0, RenderMode::kFull);
+  const PinholeIntrinsics& k = frame.depth_intrinsics;
+  const int v = 240;
+  const int left_edge = static_cast<int>(std::ceil(k.cx - k.fx * 0.1 / 1.0));
+  const double shadow = k.fx * 0.05 * (1.0 / 1.0 - 1.0 / 2.0);  // about 13 px
+  int missing_left = 0, shadow_cause = 0;
+  for (int u = left_edge - static_cast<int>(shadow) + 2; u < left_edge - 2; ++u) {
+    missing_left += frame.depth[v * k.width + u] == 0;
+    shadow_cause += sensor.missing_causes()[v * k.width + u] == MissingCause::kShadow;
+  }
+  EXPECT_EQ(missing_left, static_cast<int>(shadow) - 4);
+  EXPECT_EQ(shadow_cause, static_cast<int>(shadow) - 4);
+  // Right of the board (the IR camera's side) no shadow: the wall is measured a few pixels
+  // beyond the edge.
+  const int right_edge = static_cast<int>(std::floor(k.cx + k.fx * 0.1 / 1.0));
+  int valid_right = 0;
+  for (int u = right_edge + 8; u < right_edge + 20; ++u) valid_right += frame.depth[v * k.width + u] != 0;
+  EXPECT_GE(valid_right, 10);
+}
+
+TEST(StructuredLight, FramesAreIndependentOfTheThreadCountAndFollowTheSeed) {
+  auto render = [](int threads, uint64_t seed) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+    KinectSensorOptions options = StructuredLight();
+    options.seed = seed;
+    return RenderWall(1.7, SurfaceMaterial{0.4, 0.1}, options, 3);
+  };
+  const RgbdFrame one = render(1, 5), two = render(2, 5), other = render(2, 6);
+  EXPECT_EQ(one.depth, two.depth);
+  EXPECT_EQ(one.rgb, two.rgb);
+  EXPECT_NE(one.depth, other.depth);
+}
+
+TEST(StructuredLight, NonsenseOptionsAreRejectedNamingTheField) {
+  RayScene scene;
+  scene.AddStatic("wall", Quad(20, 20), WallAt(2.0));
+  scene.Commit();
+  KinectSensorOptions options = StructuredLight();
+  options.structured_light.window_px = 8;
+  try {
+    KinectSensor sensor(options, &scene, Rigid3::Identity());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("sensor.structured_light.window_px"));
+    EXPECT_THAT(e.what(), HasSubstr("8"));
+  }
+  SurfaceMaterial bad{1.5, 0.0};
+  EXPECT_THROW(bad.Validate("scene.materials.table"), InputError);
+}
+
+}  // namespace
+}  // namespace mmh::sim
