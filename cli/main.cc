@@ -6,8 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "cli/argument_checks.h"
 #include "cli/command_registry.h"
 #include "core/error.h"
+#include "core/error_text.h"
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv, argv + argc);
@@ -18,6 +20,12 @@ int main(int argc, char** argv) {
     command.add(app, args);
   }
   try {
+    std::vector<std::string> subcommands;
+    const CLI::App& const_app = app;
+    for (const CLI::App* sub : const_app.get_subcommands([](const CLI::App*) { return true; })) {
+      subcommands.push_back(sub->get_name());
+    }
+    mmh::cli::CheckArguments(args, subcommands);
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
@@ -26,7 +34,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // CLI11 echoes the offending value whole (a 2 MB argument, control characters): shortened.
+    std::cerr << "mmh: error: " << mmh::EscapeForMessage(e.what(), 300) << '\n'
+              << "Run with --help for more information.\n";
     return 2;
   } catch (const mmh::InputError& e) {
     std::cerr << "mmh: error: " << e.what() << '\n';

@@ -59,6 +59,8 @@ nlohmann::json Provenance(const std::vector<std::string>& argv,
                           const nlohmann::json& resolved_config, int threads,
                           const nlohmann::json& timings) {
   nlohmann::json run;
+  // The marker by which a later run recognises the folder as mmh's (kMmhMarkerFiles).
+  run["writer"] = "mmh";
   run["command"] = argv;
   run["mmh_version"] = MMH_VERSION;
   run["git_commit"] = GitCommit();
