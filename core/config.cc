@@ -26,6 +26,16 @@ void Config::Set(const std::string& assignment) {
   }
   const std::string key_path = assignment.substr(0, eq);
   const std::string text = assignment.substr(eq + 1);
+  // Keys and text values are kept as JSON strings, which must be UTF-8: anything else would
+  // fail later, when the config is written or quoted (a fuzzer finding: an uncaught type_error).
+  for (const std::string& part : {key_path, text}) {
+    try {
+      (void)nlohmann::json(part).dump();
+    } catch (const nlohmann::json::type_error&) {
+      ThrowBadValue("--set " + EscapeForMessage(assignment, 80), Quote(part),
+                    "a key and value in UTF-8");
+    }
+  }
   // Not JSON: a bare string (--set montage.blend.weight=smoothstep).
   const nlohmann::json value =
       nlohmann::json::accept(text)

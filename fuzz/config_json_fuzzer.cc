@@ -12,8 +12,9 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace mmh;
-  const auto [file, sets] =
-      fuzz::SplitInput({reinterpret_cast<const char*>(data), size}, "\n--set\n");
+  // (Not a structured binding: clang 14 cannot capture one in the lambda below.)
+  const auto parts = fuzz::SplitInput({reinterpret_cast<const char*>(data), size}, "\n--set\n");
+  const std::string_view file = parts.first, sets = parts.second;
   const auto path = fuzz::WriteInput("config.json", file);
   fuzz::ExpectReadOrInputError([&] {
     Config config = Config::Load(path);
