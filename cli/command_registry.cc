@@ -4,8 +4,12 @@
 #include <algorithm>
 #include <exception>
 #include <iostream>
+#include <string>
+#include <vector>
 
+#include "cli/argument_checks.h"
 #include "core/error.h"
+#include "core/error_text.h"
 
 namespace mmh::cli {
 namespace {
@@ -29,6 +33,12 @@ std::vector<RegisteredCommand> RegisteredCommands() {
 
 int ParseAndRun(CLI::App& app, int argc, char** argv) {
   try {
+    std::vector<std::string> subcommands;
+    const CLI::App& const_app = app;
+    for (const CLI::App* sub : const_app.get_subcommands([](const CLI::App*) { return true; })) {
+      subcommands.push_back(sub->get_name());
+    }
+    CheckArguments(std::vector<std::string>(argv, argv + argc), subcommands);
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
@@ -37,7 +47,9 @@ int ParseAndRun(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // CLI11 echoes the offending value whole (a 2 MB argument, control characters): shortened.
+    std::cerr << "mmh: error: " << mmh::EscapeForMessage(e.what(), 300) << '\n'
+              << "Run with --help for more information.\n";
     return 2;
   } catch (const mmh::InputError& e) {
     std::cerr << "mmh: error: " << e.what() << '\n';

@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/rgbd_folder.h"
 #include "core/tum_io.h"
 #include "montage/compose.h"
 #include "montage/layered.h"
@@ -90,23 +91,31 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
   summary["take_files"] = args.takes;
   summary["annotation_files"] = args.annotations;
 
+  // Timings differ on every run: they go to run.json only, so summary.json is a pure function of
+  // the inputs and config (DESIGN.md, "Determinism").
+  const nlohmann::json timings = summary["seconds"];
+  summary.erase("seconds");
+
+  // The folder is complete or absent: every file goes into a staging folder beside it, which is
+  // renamed into place at the end (a failure or a kill leaves no partial folder under --out).
   const std::filesystem::path out = args.common.out_dir;
-  EnsureDirectory(out);
-  WriteTum(out / "montage.tum", montage.trajectory,
+  StagedFolder staged(out);
+  const std::filesystem::path& dir = staged.staging();
+  WriteTum(dir / "montage.tum", montage.trajectory,
            "MotionMontage montage of " + std::to_string(takes.size()) + " takes (mmh compose)\n" +
                "timestamp tx ty tz qx qy qz qw");
-  WriteFileAtomically(out / "segments.csv", montage::SegmentsToCsv(montage.segments));
+  WriteFileAtomically(dir / "segments.csv", montage::SegmentsToCsv(montage.segments));
   if (!marker_poses.empty()) {
-    WriteTum(out / "markers.tum", marker_poses,
+    WriteTum(dir / "markers.tum", marker_poses,
              "spatial markers: montage poses at the marked frames");
   }
-  WriteFileAtomically(out / "timeline.csv", montage::TimelineToCsv(montage));
-  if (!glb.empty()) WriteFileAtomically(out / "montage.glb", glb);
-  WriteFileAtomically(out / "summary.json", summary.dump(2) + "\n");
-  WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
-  WriteFileAtomically(
-      out / "run.json",
-      Provenance(argv, resolved, args.common.threads, summary["seconds"]).dump(2) + "\n");
+  WriteFileAtomically(dir / "timeline.csv", montage::TimelineToCsv(montage));
+  if (!glb.empty()) WriteFileAtomically(dir / "montage.glb", glb);
+  WriteFileAtomically(dir / "summary.json", summary.dump(2) + "\n");
+  WriteFileAtomically(dir / "config.resolved.json", resolved.dump(2) + "\n");
+  WriteFileAtomically(dir / "run.json",
+                      Provenance(argv, resolved, args.common.threads, timings).dump(2) + "\n");
+  staged.Commit();
 
   if (!args.common.quiet) {
     const auto& s = montage.summary;

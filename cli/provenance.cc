@@ -64,6 +64,8 @@ nlohmann::json Provenance(const std::vector<std::string>& argv,
                           const nlohmann::json& resolved_config, int threads,
                           const nlohmann::json& timings) {
   nlohmann::json run;
+  // The marker by which a later run recognises the folder as mmh's (kMmhMarkerFiles).
+  run["writer"] = "mmh";
   run["command"] = argv;
   // Relative paths in the command and the results are relative to it (mmh report reads the takes).
   run["working_directory"] = std::filesystem::current_path().string();

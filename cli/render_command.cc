@@ -25,18 +25,24 @@ void RunRender(const CommonFlags& common, const std::vector<std::string>& argv) 
   const auto threads = LimitThreads(common.threads);
   const bool bar = ShowProgress(common);
   const std::filesystem::path out = common.out_dir;
-  const sim::RenderSummary summary = sim::RenderSequence(render, out, [&](int done, int total) {
+  const nlohmann::json resolved = render.ToJson();
+  nlohmann::json timings;
+  const auto progress = [&](int done, int total) {
     if (bar && (done % 10 == 0 || done == total)) {
       std::cerr << "\rrender: " << done << " / " << total << " frames" << std::flush;
       if (done == total) std::cerr << '\n';
     }
-  });
-  const nlohmann::json resolved = render.ToJson();
-  nlohmann::json timings = summary.ToJson();
-  WriteFileAtomically(out / "render_summary.json", timings.dump(2) + "\n");
-  WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
-  WriteFileAtomically(out / "run.json",
-                      Provenance(argv, resolved, common.threads, timings).dump(2) + "\n");
+  };
+  // The run's own files go into the staging folder too: the folder appears whole or not at all.
+  const auto add_run_files = [&](const std::filesystem::path& staging,
+                                 const sim::RenderSummary& summary) {
+    timings = summary.ToJson();
+    WriteFileAtomically(staging / "render_summary.json", timings.dump(2) + "\n");
+    WriteFileAtomically(staging / "config.resolved.json", resolved.dump(2) + "\n");
+    WriteFileAtomically(staging / "run.json",
+                        Provenance(argv, resolved, common.threads, timings).dump(2) + "\n");
+  };
+  const sim::RenderSummary summary = sim::RenderSequence(render, out, progress, add_run_files);
   if (!common.quiet) {
     std::cout << "render: " << summary.frames << " frames in " << summary.seconds << " s ("
               << timings["frames_per_second"].get<double>() << " frames/s rendering; writing "

@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/rgbd_folder.h"
 #include "study/figures.h"
 #include "study/paper_comparison.h"
 #include "study/simulated_study.h"
@@ -175,8 +176,10 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
     }
   }
 
-  const std::filesystem::path out = args.common.out_dir;
-  EnsureDirectory(out);
+  // Complete or absent: every file goes into a staging folder renamed into place at the end (a
+  // kill while writing leaves no partial --out; the next run removes the staging folder).
+  StagedFolder staged(args.common.out_dir);
+  const std::filesystem::path& out = staged.staging();
   study::WriteStudyData(out, s.data);
   WriteFileAtomically(out / "results.json", results.dump(2) + "\n");
   WriteFileAtomically(out / "tests.csv", s.analysis.TestsCsv());
@@ -229,10 +232,11 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
                                   {"total", SecondsSince(start)}};
   WriteFileAtomically(out / "run.json",
                       Provenance(argv, resolved, args.common.threads, timings).dump(2) + "\n");
+  staged.Commit();
   if (!args.common.quiet) {
     std::cout << report << "\nstudy: " << replicates << " replicate(s) of "
               << study_config.study.animators << " animators in " << SecondsSince(start)
-              << " s\nwritten: " << out.string()
+              << " s\nwritten: " << args.common.out_dir
               << "/{rankings.csv, comparisons.csv, segment_costs.csv, results.json, tests.csv, "
                  "take_scores.csv, animator_scores.csv, mean_ranks.csv, animators.csv, "
                  "figure8..11 .svg/.csv, paper_comparison.md/.csv, "

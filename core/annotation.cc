@@ -5,6 +5,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/error_text.h"
 #include "core/text_parsing.h"
 
 namespace mmh {
@@ -33,24 +34,22 @@ Annotation ReadAnnotationCsv(const std::filesystem::path& path) {
     if (!header_seen) {
       const auto names = SplitCsvFields(content);
       if (names.size() != 2 || Trim(names[0]) != "timestamp" || Trim(names[1]) != "value") {
-        ThrowBadValue(where, "the header '" + std::string(content) + "'",
-                      "the header 'timestamp,value'");
+        ThrowBadValue(where, "the header " + Quote(content), "the header 'timestamp,value'");
       }
       header_seen = true;
       continue;
     }
     const auto fields = SplitCsvFields(content);
     if (fields.size() != 2) {
-      ThrowBadValue(where,
-                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
+      ThrowBadValue(where, std::to_string(fields.size()) + " fields (" + Quote(content) + ")",
                     "2 fields: timestamp,value");
     }
     double timestamp = 0.0, value = 0.0;
     if (!ParseDouble(fields[0], &timestamp) || !std::isfinite(timestamp)) {
-      ThrowBadValue(where + ", timestamp", "'" + std::string(fields[0]) + "'", "a finite number");
+      ThrowBadValue(where + ", timestamp", Quote(fields[0]), "a finite number");
     }
     if (!ParseDouble(fields[1], &value)) {
-      ThrowBadValue(where + ", value", "'" + std::string(fields[1]) + "'", "a number in [-5, 5]");
+      ThrowBadValue(where + ", value", Quote(fields[1]), "a number in [-5, 5]");
     }
     CheckValue(value, where);
     if (!annotation.timestamps.empty() && !(timestamp > annotation.timestamps.back())) {

@@ -3,11 +3,15 @@
 #include <charconv>
 #include <cmath>
 
+#include "core/error_text.h"
+
 namespace mmh {
 
 std::string DescribeBadValue(const std::string& where, const std::string& value,
                              const std::string& expected) {
-  return where + ": got " + value + ", expected " + expected;
+  // The value is the part that may come from outside: a safety net for readers that did not
+  // Quote() it (callers quote fields themselves, with a tighter limit).
+  return where + ": got " + EscapeForMessage(value, 160) + ", expected " + expected;
 }
 
 void ThrowBadValue(const std::string& where, const std::string& value,

@@ -16,15 +16,13 @@
 #include <system_error>
 
 #include "core/error.h"
+#include "core/error_text.h"
+#include "core/resource_limits.h"
 
 namespace mmh {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Largest accepted image side [px], as PinholeIntrinsics::Validate: a header claiming more is
-// corrupt, not a real camera, and must not make us allocate gigabytes.
-constexpr int kMaxImageSide = 16384;
 
 // An OpenImageIO error message without its trailing new line, for our one-line messages.
 std::string OiioMessage(std::string message) {
@@ -58,10 +56,53 @@ std::string DescribeFormat(const OIIO::ImageSpec& spec, const std::string& forma
          " " + format_name + " image";
 }
 
+// A PNG's chunk structure (length, type, data, CRC; IHDR first, IEND last), checked before
+// libpng reads it: libpng prints its errors to stderr ("libpng error: ... hit end of file"), even
+// under --quiet, and a truncated file is the common case. No-op for other formats.
+void CheckPngChunks(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  char signature[8] = {};
+  if (!in.read(signature, 8) || std::string(signature, 8) != "\x89PNG\r\n\x1A\n") return;
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) return;
+  std::uintmax_t pos = 8;
+  bool first = true;
+  while (true) {
+    unsigned char header[8];
+    if (pos + 8 > size || !in.read(reinterpret_cast<char*>(header), 8)) {
+      ThrowBadValue(path.string(),
+                    "a truncated PNG (" + std::to_string(size) + " bytes, no IEND chunk)",
+                    "a complete PNG file");
+    }
+    const std::uintmax_t length =
+        (std::uintmax_t{header[0]} << 24) | (header[1] << 16) | (header[2] << 8) | header[3];
+    const std::string type(reinterpret_cast<const char*>(header) + 4, 4);
+    if ((first && type != "IHDR") || length > 0x7FFFFFFF) {
+      ThrowBadValue(path.string(),
+                    "a corrupt PNG (chunk " + Quote(type) + " at byte " + std::to_string(pos) + ")",
+                    "a valid PNG file");
+    }
+    first = false;
+    const std::uintmax_t end = pos + 12 + length;
+    if (end > size) {
+      ThrowBadValue(path.string(),
+                    "a truncated PNG (chunk " + Quote(type) + " at byte " + std::to_string(pos) +
+                        " needs " + std::to_string(end) + " bytes, the file has " +
+                        std::to_string(size) + ")",
+                    "a complete PNG file");
+    }
+    if (type == "IEND") return;
+    pos = end;
+    in.seekg(static_cast<std::streamoff>(pos));
+  }
+}
+
 // Opens `path` with OpenImageIO; InputError naming the path when it cannot.
 std::unique_ptr<OIIO::ImageInput> OpenImage(const fs::path& path,
                                             const OIIO::ImageSpec* config = nullptr) {
   RequireReadableFile(path);
+  CheckPngChunks(path);
   auto input = OIIO::ImageInput::open(path.string(), config);
   if (!input) {
     ThrowBadValue(path.string(), "an unreadable image (" + OiioMessage(OIIO::geterror()) + ")",

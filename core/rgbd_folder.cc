@@ -1,9 +1,11 @@
 #include "core/rgbd_folder.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <mutex>
@@ -15,7 +17,9 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/error_text.h"
 #include "core/image_io.h"
+#include "core/json_text.h"
 #include "core/options.h"
 #include "core/text_parsing.h"
 #include "core/tum_io.h"
@@ -102,18 +106,13 @@ PinholeIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::stri
 }
 
 nlohmann::json ReadJsonFile(const fs::path& path) {
-  const std::string text = ReadTextFile(path);
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    ThrowBadValue(path.string(), "invalid JSON (" + std::string(e.what()) + ")", "a JSON object");
-  }
+  return ParseJsonText(ReadTextFile(path, kMaxJsonFileBytes), path.string());
 }
 
 // camera.json -> camera info; `extra` receives the "extra" object.
 RgbdCameraInfo CameraInfoFromJson(const fs::path& path, nlohmann::json* extra) {
   const nlohmann::json json = ReadJsonFile(path);
-  if (!json.is_object()) ThrowBadValue(path.string(), json.dump(), "a JSON object");
+  if (!json.is_object()) ThrowBadValue(path.string(), Quote(json.dump()), "a JSON object");
   static const char* kKnown[] = {"writer",        "format",           "frames",
                                  "depth_scale",   "depth_intrinsics", "color_intrinsics",
                                  "color_T_depth", "sensor",           "extra"};
@@ -173,8 +172,8 @@ void RequireReplaceable(const fs::path& target) {
   }
   if (!ours) {
     ThrowBadValue(target.string(),
-                  "an existing folder that mmh did not write (no camera.json or fakenect.json "
-                  "with \"writer\": \"mmh\")",
+                  "an existing folder that mmh did not write (no camera.json, fakenect.json or "
+                  "run.json with \"writer\": \"mmh\")",
                   expected);
   }
 }
@@ -266,10 +265,55 @@ std::optional<RgbdCameraInfo> TumCameraInfoFromName(const std::string& folder_na
 // ---------------------------------------------------------------------------------------------
 // Staged output folders
 
+namespace {
+
+// Removes the staging folders ('<target>.partial-<pid>') and set-aside folders ('.old-<pid>') of
+// `target` left by processes that no longer run (a SIGKILLed render): otherwise each killed run
+// leaves up to tens of MB for ever. Folders of live processes (a concurrent writer) are kept.
+// Process ids are those of this machine: writers of one folder on several hosts are not supported.
+void RemoveStaleStaging(const fs::path& target) {
+  const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const std::string name = target.filename().string();
+  std::error_code ec;
+  fs::directory_iterator it(parent, ec);
+  if (ec) return;
+  for (const fs::directory_entry& entry : it) {
+    const std::string entry_name = entry.path().filename().string();
+    for (const std::string suffix : {".partial-", ".old-"}) {
+      if (!entry_name.starts_with(name + suffix)) continue;
+      const std::string digits = entry_name.substr(name.size() + suffix.size());
+      if (digits.empty() || digits.size() > 9 ||
+          !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        continue;
+      }
+      const pid_t pid = static_cast<pid_t>(std::stol(digits));
+      if (pid == ::getpid()) continue;                      // ours: handled by the caller
+      if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+      std::error_code ignored;
+      // A kill between Commit()'s two renames leaves the old folder aside and no target: put it
+      // back (the rerun replaces it whole).
+      if (suffix == ".old-" && !fs::exists(fs::symlink_status(target, ignored))) {
+        fs::rename(entry.path(), target, ignored);
+        if (!ignored) continue;
+      }
+      fs::remove_all(entry.path(), ignored);
+    }
+  }
+}
+
+}  // namespace
+
 StagedFolder::StagedFolder(const fs::path& target) : target_(WithoutTrailingSeparator(target)) {
   RequireReplaceable(target_);
   const fs::path parent = target_.parent_path().empty() ? fs::path(".") : target_.parent_path();
-  EnsureDirectory(parent);
+  std::error_code parent_error;
+  fs::create_directories(parent, parent_error);
+  if (!fs::is_directory(parent)) {
+    ThrowBadValue(target_.string(),
+                  "a parent folder that cannot be created (" + parent_error.message() + ")",
+                  "a writable output folder");
+  }
+  RemoveStaleStaging(target_);
   staging_ = target_;
   staging_ += ".partial-" + std::to_string(::getpid());
   {

@@ -62,8 +62,8 @@ std::optional<RgbdCameraInfo> TumCameraInfoFromName(const std::string& folder_na
 // folder, and destruction without Commit() removes the staging folder.
 //
 // An existing target is replaced only when it is empty or was written by mmh (it holds a marker
-// file, camera.json or fakenect.json, whose "writer" is "mmh"); anything else is an InputError
-// naming it, checked when the StagedFolder is made and again in Commit().
+// file, camera.json, fakenect.json or run.json, whose "writer" is "mmh"); anything else is an
+// InputError naming it, checked when the StagedFolder is made and again in Commit().
 class StagedFolder {
  public:
   explicit StagedFolder(const std::filesystem::path& target);
@@ -85,7 +85,7 @@ class StagedFolder {
 };
 
 // The marker files by which an output folder is recognised as mmh's (their "writer" is "mmh").
-inline constexpr const char* kMmhMarkerFiles[] = {"camera.json", "fakenect.json"};
+inline constexpr const char* kMmhMarkerFiles[] = {"camera.json", "fakenect.json", "run.json"};
 inline constexpr const char* kMmhWriterName = "mmh";
 
 // Writes one sequence through a StagedFolder: Finish() moves it into place, a writer destroyed

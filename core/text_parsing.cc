@@ -7,10 +7,40 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/error_text.h"
 
 namespace mmh {
 
-std::string ReadTextFile(const std::filesystem::path& path) {
+namespace {
+
+std::string FormatBytes(std::size_t bytes) {
+  if (bytes >= (std::size_t{1} << 20) && bytes % (std::size_t{1} << 20) == 0) {
+    return std::to_string(bytes >> 20) + " MiB";
+  }
+  return std::to_string(bytes) + " bytes";
+}
+
+// Names what the start of a file that is not UTF-8 text looks like, or "" if it may be text.
+std::string NotText(std::string_view head) {
+  auto starts = [&](std::string_view prefix) { return head.starts_with(prefix); };
+  using namespace std::string_view_literals;
+  if (starts("\xFF\xFE\0\0"sv) || starts("\0\0\xFE\xFF"sv)) {
+    return "a UTF-32 file (byte-order mark)";
+  }
+  if (starts("\xFF\xFE") || starts("\xFE\xFF")) return "a UTF-16 file (byte-order mark)";
+  const std::size_t nul = head.find('\0');
+  if (nul == std::string_view::npos) return "";
+  // UTF-16 without a mark: ASCII characters with a NUL byte beside every one.
+  if (head.size() >= 4 && (head[1] == '\0' || head[0] == '\0') &&
+      (head[3] == '\0' || head[2] == '\0') && head.find("\0\0"sv) == std::string_view::npos) {
+    return "a UTF-16 file (NUL bytes between the characters)";
+  }
+  return "binary data (a NUL byte at offset " + std::to_string(nul) + ")";
+}
+
+}  // namespace
+
+std::string ReadTextFile(const std::filesystem::path& path, std::size_t max_bytes) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     ThrowBadValue(path.string(), "a path that does not exist", "an existing, readable file");
@@ -23,9 +53,36 @@ std::string ReadTextFile(const std::filesystem::path& path) {
     ThrowBadValue(path.string(), "an unreadable file (" + std::string(std::strerror(errno)) + ")",
                   "a readable file");
   }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
+  // Read in chunks up to the limit: a device or FIFO has no size to check first, and the first
+  // chunk already tells binary data from text.
+  std::string text;
+  constexpr std::size_t kChunk = 1 << 16;
+  const std::string expected = "a UTF-8 text file";
+  while (in) {
+    const std::size_t old_size = text.size();
+    text.resize(old_size + kChunk);
+    in.read(text.data() + old_size, kChunk);
+    text.resize(old_size + static_cast<std::size_t>(in.gcount()));
+    if (old_size == 0) {
+      const std::string what = NotText(text);
+      if (!what.empty()) ThrowBadValue(path.string(), what, expected);
+    }
+    if (text.size() > max_bytes) {
+      ThrowBadValue(path.string(), "more than " + FormatBytes(max_bytes),
+                    expected + " of at most " + FormatBytes(max_bytes));
+    }
+  }
+  if (in.bad()) {
+    ThrowBadValue(path.string(), "a read error (" + std::string(std::strerror(errno)) + ")",
+                  "a readable file");
+  }
+  const std::size_t nul = text.find('\0');
+  if (nul != std::string::npos) {
+    ThrowBadValue(path.string(), "binary data (a NUL byte at offset " + std::to_string(nul) + ")",
+                  expected);
+  }
+  if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
+  return text;
 }
 
 std::vector<std::string_view> SplitFields(std::string_view line, std::string_view delimiters) {
@@ -90,8 +147,7 @@ void ForEachDataRow(
     const std::string where = path.string() + ":" + std::to_string(line_number);
     const auto fields = SplitFields(content, " \t");
     if (fields.size() != field_count) {
-      ThrowBadValue(where,
-                    std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
+      ThrowBadValue(where, std::to_string(fields.size()) + " fields (" + Quote(content) + ")",
                     layout);
     }
     row(where, fields, line_number);

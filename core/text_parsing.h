@@ -9,8 +9,15 @@
 
 namespace mmh {
 
-// Reads a whole text file; throws InputError naming the path if it cannot be read.
-std::string ReadTextFile(const std::filesystem::path& path);
+// Largest text file read by default (trajectories of hours at 30 Hz are a few hundred MB less).
+inline constexpr std::size_t kMaxTextFileBytes = std::size_t{1} << 30;
+
+// Reads a whole UTF-8 (or ASCII) text file; throws InputError naming the path if it cannot be
+// read, if it is longer than `max_bytes` (so /dev/zero or a FIFO cannot exhaust memory), if it is
+// UTF-16 or UTF-32 (a byte-order mark or NUL bytes) or binary (a NUL byte). A UTF-8 byte-order
+// mark at the start is dropped (editors on Windows write one).
+std::string ReadTextFile(const std::filesystem::path& path,
+                         std::size_t max_bytes = kMaxTextFileBytes);
 
 // Splits on any run of the given delimiter characters, dropping empty fields.
 std::vector<std::string_view> SplitFields(std::string_view line, std::string_view delimiters);

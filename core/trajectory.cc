@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/resource_limits.h"
 
 namespace mmh {
 
@@ -39,6 +40,12 @@ void ValidateTrajectory(const Trajectory& trajectory, const std::string& name) {
     }
     if (!pose.translation.allFinite() || !pose.rotation.coeffs().allFinite()) {
       ThrowBadValue(where(), "a non-finite pose value", "finite translation and quaternion");
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (std::abs(pose.translation[k]) > kMaxTranslationMetres) {
+        ThrowBadValue(where() + ", t" + std::string(1, "xyz"[k]), FormatNumber(pose.translation[k]),
+                      "a translation within +-1e6 m (kMaxTranslationMetres)");
+      }
     }
     const double norm = pose.rotation.norm();
     if (std::abs(norm - 1.0) > 1e-6) {

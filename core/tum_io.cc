@@ -5,6 +5,8 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/error_text.h"
+#include "core/resource_limits.h"
 #include "core/text_parsing.h"
 
 namespace mmh {
@@ -18,8 +20,11 @@ Trajectory ReadTum(const std::filesystem::path& path) {
         static const char* kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
         for (int i = 0; i < 8; ++i) {
           if (!ParseDouble(fields[i], &v[i]) || !std::isfinite(v[i])) {
-            ThrowBadValue(where + ", field " + kNames[i], "'" + std::string(fields[i]) + "'",
-                          "a finite number");
+            ThrowBadValue(where + ", field " + kNames[i], Quote(fields[i]), "a finite number");
+          }
+          if (i >= 1 && i <= 3 && std::abs(v[i]) > kMaxTranslationMetres) {
+            ThrowBadValue(where + ", field " + kNames[i], Quote(fields[i]),
+                          "a translation within +-1e6 m (metres; kMaxTranslationMetres)");
           }
         }
         Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);

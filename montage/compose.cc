@@ -55,6 +55,20 @@ void ValidateInputs(const std::vector<Trajectory>& takes,
       ThrowBadValue(annotation_name, std::to_string(annotations[i].size()) + " rows",
                     std::to_string(takes[i].size()) + " rows, one per frame of " + take_name);
     }
+    // The annotation is per frame of its take (DESIGN.md, "File formats"): its timestamps must be
+    // the take's, within a quarter frame (an annotation in milliseconds, or of another take, or
+    // shifted by seconds, would otherwise be used silently).
+    const double period = MedianFramePeriod(takes[i].timestamps);
+    const double tolerance = period > 0 ? 0.25 * period : 1e-3;
+    for (std::size_t k = 0; k < takes[i].size(); ++k) {
+      const double a = annotations[i].timestamps[k], t = takes[i].timestamps[k];
+      if (!(std::abs(a - t) <= tolerance)) {
+        ThrowBadValue(
+            annotation_name + ", row " + std::to_string(k + 1) + ", timestamp", FormatNumber(a),
+            "the timestamp of frame " + std::to_string(k) + " of " + take_name + ", " +
+                FormatNumber(t) + " s (within a quarter frame, " + FormatNumber(tolerance) + " s)");
+      }
+    }
     if (d > 0 && static_cast<int>(takes[i].size()) <= d) {
       ThrowBadValue(take_name, std::to_string(takes[i].size()) + " frames",
                     "more than montage.labelling.min_segment_length = " + std::to_string(d) +

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/resource_limits.h"
 #include "montage/internal/pose_arrays.h"
 #include "montage/match_cost.h"
 
@@ -499,7 +500,9 @@ double Symmetric(const PoseArrays& ref, const PoseArrays& src, double lambda,
     CostRun(ref, t, src, 0, big_n, lambda, cost.data());
     for (int s = 0; s < big_n; ++s) {
       double best = kInf;
-      std::uint8_t k = 0;
+      // The default move stays inside the matrix even when every predecessor is +inf: the walk
+      // back must never leave it (on row 0 only "from the left", on column 0 only "from above").
+      std::uint8_t k = t == 0 ? 2 : (s == 0 ? 1 : 0);
       if (t == 0 && s == 0) best = 0;
       if (t > 0 && s > 0 && prev[s - 1] < best) best = prev[s - 1], k = 0;
       if (t > 0 && prev[s] < best) best = prev[s], k = 1;
@@ -567,6 +570,22 @@ DtwResult ComputeDtw(const Trajectory& reference, const Trajectory& source,
         "a source of " + std::to_string(big_n) + " frames for a reference of " + std::to_string(n),
         "a source at most 2 (n - 1) + 1 frames long");
   }
+  // Translations beyond kMaxTranslationMetres can overflow the costs (1e200^2 = inf).
+  // (Only the values: callers may pass poses without timestamps.)
+  for (const auto& [take, name] : {std::pair{&reference, "reference"}, {&source, "source"}}) {
+    for (std::size_t i = 0; i < take->size(); ++i) {
+      const Rigid3& pose = take->poses[i];
+      if (!pose.rotation.coeffs().allFinite() || !pose.translation.allFinite() ||
+          pose.translation.cwiseAbs().maxCoeff() > kMaxTranslationMetres) {
+        ThrowBadValue(std::string("DTW ") + name + " take, frame " + std::to_string(i),
+                      "translation (" + FormatNumber(pose.translation.x()) + ", " +
+                          FormatNumber(pose.translation.y()) + ", " +
+                          FormatNumber(pose.translation.z()) + ")",
+                      "finite values within +-1e6 m (kMaxTranslationMetres) and a finite "
+                      "quaternion");
+      }
+    }
+  }
   const PoseArrays ref(reference), src(source);
   DtwResult result;
   result.summary.cells_total = static_cast<std::int64_t>(n) * big_n;
@@ -590,6 +609,16 @@ DtwResult ComputeDtw(const Trajectory& reference, const Trajectory& source,
     case StepPattern::kSymmetric:
       cost = Symmetric(ref, src, options.lambda, &result.warp, &evaluated);
       break;
+  }
+  // Every cost is finite for poses within kMaxTranslationMetres; an infinite optimum (costs that
+  // overflowed) has no meaningful warp, and the literal programme returns none.
+  if (!std::isfinite(cost) || static_cast<int>(result.warp.size()) != n) {
+    ThrowBadValue(
+        "DTW (step_pattern " +
+            std::string(kStepPatternNames[static_cast<int>(options.step_pattern)].second) + ")",
+        "a warp cost of " + FormatNumber(cost),
+        "finite matching costs (eq. 5): poses with finite translations within +-" +
+            FormatNumber(kMaxTranslationMetres) + " m and finite quaternions");
   }
   result.summary.cost = cost;
   result.summary.cells_evaluated = evaluated;

@@ -197,6 +197,14 @@ RunConfig RunConfig::FromConfig(const Config& config,
                   "an object of " + c.render.render.story + " (0.." +
                       std::to_string(story.objects.size() - 1) + ")");
   }
+  // Takes the montage would refuse (no longer than the shortest segment) are refused now, before
+  // anything is performed, rendered or tracked.
+  const int d = c.montage.labelling.min_segment_length;
+  if (c.render.render.frames > 0 && d > 0 && c.render.render.frames <= d) {
+    ThrowBadValue("render.frames", std::to_string(c.render.render.frames),
+                  "0 (whole takes) or more than montage.labelling.min_segment_length = " +
+                      std::to_string(d) + " frames (the shortest segment a montage may take)");
+  }
   if (!c.run.practice.empty()) sim::LoadStory(c.run.practice, c.render.scene);
   if (std::abs(c.render.performance.frame_rate - c.render.sensor.frame_rate) > 1e-9) {
     ThrowBadValue("performance.frame_rate", FormatNumber(c.render.performance.frame_rate),
@@ -286,6 +294,19 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
       t.truth_annotation = t.annotation.SliderAnnotation(render.performance.frame_rate);
       t.truth_annotation.timestamps.resize(frames);
       t.truth_annotation.values.resize(frames);
+    }
+  }
+  // A performed take can be shorter than render.frames: refuse it before rendering (the montage
+  // would, after all the work).
+  const int d = config.montage.labelling.min_segment_length;
+  for (std::size_t slot = practice_takes; slot < takes.size(); ++slot) {
+    const int frames = static_cast<int>(takes[slot].truth.size());
+    if (d > 0 && frames <= d) {
+      ThrowBadValue("take " + std::to_string(takes[slot].take) + " of animator " +
+                        std::to_string(animator) + " (" + render.render.story + ")",
+                    std::to_string(frames) + " frames",
+                    "more than montage.labelling.min_segment_length = " + std::to_string(d) +
+                        " frames (the shortest segment a montage may take)");
     }
   }
   result.seconds.perform = SecondsSince(t0);

@@ -397,8 +397,10 @@ Rigid3 RestingTableTProxy() {
   return Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(kRestingProxyX, 0, 0));
 }
 
-RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
-                             const std::function<void(int, int)>& progress) {
+RenderSummary RenderSequence(
+    const RenderConfig& config, const std::filesystem::path& out,
+    const std::function<void(int, int)>& progress,
+    const std::function<void(const std::filesystem::path&, const RenderSummary&)>& before_commit) {
   const RenderOptions& r = config.render;
   // Read and check every input before the first frame.
   const Motion motion = ResolveMotion(config);
@@ -500,17 +502,21 @@ RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::
   scene_json["table"] = mmh::ToJson(config.scene);
   scene_json["slider_block_size"] = config.scene.slider_block_size;
   scene_json["groundtruth"] = "groundtruth.txt: camera_T_proxy of the depth camera";
-  writer.Finish(groundtruth, {{"scene", scene_json}});
-  WritePly(proxy_model, out / "model.ply");
-  WriteAnnotationCsv(out / "slider.csv", slider_truth);
-  WriteFileAtomically(out / "scene.json", scene_json.dump(2) + "\n");
-  if (motion.take) WriteStoryFiles(motion, config, out);
-  if (fakenect) fakenect->Finish();
+  // Everything goes into the staging folder before it is moved into place: a kill at any moment
+  // leaves no partial folder under `out` (a later render removes the staging folder).
+  const std::filesystem::path& staging = writer.staging();
+  WritePly(proxy_model, staging / "model.ply");
+  WriteAnnotationCsv(staging / "slider.csv", slider_truth);
+  WriteFileAtomically(staging / "scene.json", scene_json.dump(2) + "\n");
+  if (motion.take) WriteStoryFiles(motion, config, staging);
   if (r.bop) {
-    EnsureDirectory(out / "bop" / "models");
-    WriteBopScene(out / "bop", bop, camera.depth_intrinsics, camera.depth_scale);
-    WritePly(proxy_model, out / "bop" / "models" / "obj_000001.ply", 1000.0);
+    EnsureDirectory(staging / "bop" / "models");
+    WriteBopScene(staging / "bop", bop, camera.depth_intrinsics, camera.depth_scale);
+    WritePly(proxy_model, staging / "bop" / "models" / "obj_000001.ply", 1000.0);
   }
+  if (before_commit) before_commit(staging, summary);
+  writer.Finish(groundtruth, {{"scene", scene_json}});
+  if (fakenect) fakenect->Finish();
   return summary;
 }
 

@@ -200,8 +200,11 @@ Rigid3 RestingTableTProxy();
 // take.tum (table_T_proxy of the whole take), take.csv (per frame: beat, performed action, latent
 // quality and its factors; annotation sessions also the judgement, delay and slider), flaws.csv and
 // participant.json. Everything is read and checked before the first frame; folders appear
-// complete or not at all.
+// complete or not at all: `before_commit(staging, summary)`, when given, adds the caller's files
+// (run.json, ...) to the staging folder before it is moved to `out`.
 RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
-                             const std::function<void(int, int)>& progress = {});
+                             const std::function<void(int, int)>& progress = {},
+                             const std::function<void(const std::filesystem::path&,
+                                                      const RenderSummary&)>& before_commit = {});
 
 }  // namespace mmh::sim

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/text_parsing.h"
 #include "stats/binomial_test.h"
 
@@ -506,13 +507,8 @@ PaperAudit AuditPaper(const nlohmann::json& reported, const std::string& source,
 PaperAudit AuditPaperFile(const std::filesystem::path& reported,
                           const std::optional<std::filesystem::path>& paper) {
   const std::string text = ReadTextFile(reported);
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    ThrowBadValue(reported.string(), "invalid JSON (" + std::string(e.what()) + ")",
-                  "a JSON object with a 'checks' array");
-  }
+  // Repeated keys are errors, syntax errors name the line and column (core/json_text.h).
+  const nlohmann::json json = ParseJsonText(text, reported.string());
   std::optional<std::string> paper_text;
   if (paper) paper_text = ReadTextFile(*paper);
   return AuditPaper(json, reported.string(), paper_text);

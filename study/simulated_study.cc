@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/options.h"
+#include "core/resource_limits.h"
 #include "people/random.h"
 #include "stats/binomial_test.h"
 
@@ -67,9 +68,12 @@ void SimulatedStudyOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".animators", std::to_string(animators),
                   "at least 3 animators (the normality tests need 3)");
   }
+  // Up front, not after hours: a study of 10^6 animators (a typo) would run for weeks.
+  RequireAtMost(animators, kMaxPeople, prefix + ".animators", "animators");
   if (replicates < 1) {
     ThrowBadValue(prefix + ".replicates", std::to_string(replicates), "at least 1");
   }
+  RequireAtMost(replicates, 10'000, prefix + ".replicates", "replicates");
   RequireFinite(alpha, prefix + ".alpha");
   if (alpha <= 0 || alpha >= 1) ThrowBadValue(prefix + ".alpha", Num(alpha), "a level in (0, 1)");
   analysis.Validate(prefix + ".analysis");

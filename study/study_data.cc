@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/error_text.h"
 #include "core/text_parsing.h"
 #include "stats/descriptive.h"
 
@@ -341,6 +342,13 @@ void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
       ThrowBadValue(where + ", column 'cost_constrained'", FormatNumber(s.cost_constrained),
                     "at least cost_unconstrained = " + FormatNumber(s.cost_unconstrained) +
                         " (a constraint cannot lower the optimum)");
+    }
+    // A cost row of an animator who ranked nothing is a typo or another study's row: the
+    // segment-constraint analysis would silently use it.
+    if (!by_animator.count(s.animator)) {
+      ThrowBadValue(where + ", column 'animator'", Quote(s.animator),
+                    "an animator of " + data.rankings_source + " (" +
+                        std::to_string(by_animator.size()) + " animators)");
     }
     const auto [it, inserted] = cost_lines.emplace(s.animator, s.line);
     if (!inserted) {

@@ -5,6 +5,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/error_text.h"
 #include "core/tum_io.h"
 #include "track/table_plane.h"
 
@@ -158,11 +159,15 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
   run.summary.init = config.run.init == TrackInit::kTruth ? "truth" : "detection";
   RgbdFrame frame;
   double last_value = 0.0;
+  int unreadable = 0;
+  std::string first_unreadable;
   using Clock = std::chrono::steady_clock;
   while ((config.run.max_frames == 0 || run.summary.frames < config.run.max_frames) &&
          source.Next(&frame)) {
     const auto start = Clock::now();
     const bool readable = source.frame_error().empty();
+    if (!readable && first_unreadable.empty()) first_unreadable = source.frame_error();
+    unreadable += !readable;
     TrackFrameResult result;
     std::string no_table = "no table plane yet";
     const std::optional<Rigid3>* camera_T_table = nullptr;
@@ -210,6 +215,14 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
       run.trajectory.poses.push_back(pose);
     }
     if (progress) progress(run.summary.frames, source.size());
+  }
+  // One unreadable frame is lost; a source none of whose frames can be read (8-bit depth PNGs,
+  // every image truncated) is bad input, not a failure to track.
+  if (run.summary.frames > 0 && unreadable == run.summary.frames) {
+    ThrowBadValue(source.Describe(),
+                  "no readable frame among " + std::to_string(unreadable) +
+                      " (the first: " + EscapeForMessage(first_unreadable, 300) + ")",
+                  "frames whose depth and colour images can be read");
   }
   if (tracker) {
     run.camera_T_table = tracker->camera_T_table();

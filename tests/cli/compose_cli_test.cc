@@ -1,6 +1,8 @@
 // End-to-end tests of `mmh compose` as a user runs it: exit codes, messages naming the file,
 // line, key and value, no output on bad input, identical bytes on a rerun.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -9,6 +11,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "core/annotation.h"
 #include "core/text_parsing.h"
@@ -187,6 +190,88 @@ TEST_F(ComposeCliTest, UnwritableOutputIsAnInputError) {
   const auto r = RunMmh("compose " + Inputs() + " --out " + (dir_ / "file" / "sub").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("file/sub"), std::string::npos) << r.output;
+}
+
+// Takes at 1e150..1e300 m crashed the DTW (SIGSEGV, or a heap write in the symmetric pattern):
+// refused where they are read, naming the file, line and field.
+TEST_F(ComposeCliTest, HugeTranslationsAreRefusedWhereRead) {
+  for (const char* value : {"1e150", "1e200", "1e300", "1000001"}) {
+    std::ofstream huge(dir_ / "huge.tum");
+    for (int i = 0; i < 200; ++i) {
+      huge << i / 30.0 << " " << value << " " << value << " " << value << " 0 0 0 1\n";
+    }
+    huge.close();
+    for (const char* pattern : {"literal", "symmetric", "slope_limited"}) {
+      const fs::path out = dir_ / "out";
+      const auto r = RunMmh("compose --takes " + (dir_ / "take_0.tum").string() + " " +
+                            (dir_ / "huge.tum").string() + " --annotations " +
+                            (dir_ / "take_0.csv").string() + " " + (dir_ / "take_0.csv").string() +
+                            " --set montage.dtw.step_pattern=" + pattern +
+                            " --set montage.dtw.prune=false --out " + out.string());
+      EXPECT_EQ(r.exit_code, 2) << value << " " << pattern << "\n" << r.output;
+      EXPECT_NE(r.output.find("huge.tum:1, field tx: got '" + std::string(value) + "'"),
+                std::string::npos)
+          << r.output;
+      EXPECT_NE(r.output.find("within +-1e6 m"), std::string::npos) << r.output;
+      EXPECT_FALSE(fs::exists(out));
+    }
+  }
+}
+
+TEST_F(ComposeCliTest, AnnotationTimestampsMustBeTheTakes) {
+  const Annotation a = ReadAnnotationCsv(dir_ / "take_1.csv");
+  for (const auto& [name, scale, shift] :
+       {std::tuple{"milliseconds", 1000.0, 0.0}, std::tuple{"shifted", 1.0, 1000.0}}) {
+    Annotation bad = a;
+    for (double& t : bad.timestamps) t = t * scale + shift;
+    WriteAnnotationCsv(dir_ / "bad.csv", bad);
+    const fs::path out = dir_ / "out";
+    const auto r =
+        RunMmh("compose --takes " + (dir_ / "take_0.tum").string() + " " +
+               (dir_ / "take_1.tum").string() + " --annotations " + (dir_ / "take_0.csv").string() +
+               " " + (dir_ / "bad.csv").string() + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << name << "\n" << r.output;
+    EXPECT_NE(r.output.find("bad.csv, row "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("expected the timestamp of frame"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("take_1.tum"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// summary.json is a function of the inputs (timings are in run.json only), and the folder is
+// written whole: a rerun replaces it, a folder mmh did not write is never touched, and the staging
+// folder of a killed run is removed by the next.
+TEST_F(ComposeCliTest, OutputFolderIsWholeDeterministicAndReplaceable) {
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(RunMmh("compose " + Inputs() + " --out " + out.string() + " --quiet").exit_code, 0);
+  const std::string summary = ReadTextFile(out / "summary.json");
+  EXPECT_EQ(summary.find("\"seconds\""), std::string::npos) << summary;
+  EXPECT_NE(ReadTextFile(out / "run.json").find("\"seconds\""), std::string::npos);
+  // A killed run's staging folder (a process id that no longer runs).
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  waitpid(child, nullptr, 0);
+  const fs::path stale = dir_ / ("out.partial-" + std::to_string(child));
+  fs::create_directories(stale);
+  std::ofstream(stale / "montage.tum") << "half";
+  const auto rerun = RunMmh("compose " + Inputs() + " --out " + out.string() + " --quiet");
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
+  EXPECT_EQ(ReadTextFile(out / "summary.json"), summary);
+  EXPECT_FALSE(fs::exists(stale));
+  // Nothing beside the folder but the inputs.
+  for (const auto& entry : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().filename().string().find("out."), std::string::npos) << entry.path();
+  }
+  // A folder of someone else's files is refused and left as it is.
+  const fs::path theirs = dir_ / "theirs";
+  fs::create_directories(theirs);
+  std::ofstream(theirs / "notes.txt") << "mine";
+  const auto refused = RunMmh("compose " + Inputs() + " --out " + theirs.string());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("an existing folder that mmh did not write"), std::string::npos)
+      << refused.output;
+  EXPECT_EQ(ReadTextFile(theirs / "notes.txt"), "mine");
+  EXPECT_FALSE(fs::exists(theirs / "montage.tum"));
 }
 
 }  // namespace

@@ -218,7 +218,7 @@ class TextFileTest : public ::testing::Test {
 };
 
 TEST_F(TextFileTest, ReadTextFileReadsBytesVerbatim) {
-  const std::string bytes = std::string("a\r\nb\0c\n", 7);
+  const std::string bytes = std::string("a\r\nb\tc \xC2\xB1\n");
   {
     std::ofstream out(dir_ / "f.txt", std::ios::binary);
     out << bytes;
@@ -240,6 +240,63 @@ TEST_F(TextFileTest, ReadTextFileErrorsNameThePath) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr(dir_.string()));
     EXPECT_THAT(e.what(), HasSubstr("folder"));
+  }
+}
+
+std::string ErrorReading(const fs::path& path, std::size_t max_bytes = kMaxTextFileBytes) {
+  try {
+    ReadTextFile(path, max_bytes);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+TEST_F(TextFileTest, ReadTextFileDropsAUtf8ByteOrderMark) {
+  std::ofstream(dir_ / "bom.csv", std::ios::binary) << "\xEF\xBB\xBFtimestamp,value\n";
+  EXPECT_EQ(ReadTextFile(dir_ / "bom.csv"), "timestamp,value\n");
+}
+
+TEST_F(TextFileTest, ReadTextFileNamesUtf16AndBinaryFiles) {
+  // UTF-16 with and without a byte-order mark, UTF-32, binary: each named, never cut at a NUL.
+  const std::pair<std::string, std::string> cases[] = {
+      {std::string("\xFF\xFEt\0i\0m\0e\0", 10), "a UTF-16 file (byte-order mark)"},
+      {std::string("\xFE\xFF\0t\0i\0m\0e", 10), "a UTF-16 file (byte-order mark)"},
+      {std::string("t\0i\0m\0e\0s\0", 10), "a UTF-16 file (NUL bytes between"},
+      {std::string("\xFF\xFE\0\0t\0\0\0", 8), "a UTF-32 file"},
+      {std::string("PK\x03\x04\0\0\0\0garbage", 15), "binary data (a NUL byte at offset 4)"},
+  };
+  for (const auto& [bytes, named] : cases) {
+    std::ofstream(dir_ / "f.bin", std::ios::binary) << bytes;
+    const std::string message = ErrorReading(dir_ / "f.bin");
+    EXPECT_THAT(message, HasSubstr((dir_ / "f.bin").string())) << named;
+    EXPECT_THAT(message, HasSubstr(named));
+    EXPECT_THAT(message, HasSubstr("expected a UTF-8 text file"));
+  }
+}
+
+TEST_F(TextFileTest, ReadTextFileRefusesEndlessAndHugeInputs) {
+  // /dev/zero never ends: refused at its first chunk (NUL bytes), not by running out of memory.
+  EXPECT_THAT(ErrorReading("/dev/zero"), HasSubstr("/dev/zero: got binary data"));
+  std::ofstream(dir_ / "big.txt", std::ios::binary) << std::string(5000, 'x');
+  const std::string message = ErrorReading(dir_ / "big.txt", 4096);
+  EXPECT_THAT(message, HasSubstr("got more than 4096 bytes"));
+  EXPECT_THAT(message, HasSubstr("of at most 4096 bytes"));
+  EXPECT_EQ(ReadTextFile(dir_ / "big.txt", 5000).size(), 5000u);
+}
+
+TEST_F(TextFileTest, ForEachDataRowQuotesALongLineShortly) {
+  // A 2 MB line is quoted as a few dozen characters with its length, escaped.
+  std::ofstream(dir_ / "long.tum", std::ios::binary)
+      << "1 2 \x01" << std::string(2'000'000, 'y') << "\n";
+  try {
+    ForEachDataRow(dir_ / "long.tum", 8, "8 fields", [](auto&&...) {});
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_LT(message.size(), 300u) << message.substr(0, 400);
+    EXPECT_THAT(message, HasSubstr("long.tum:1: got 3 fields ('1 2 \\x01yyy"));
+    EXPECT_THAT(message, HasSubstr("(2000005 bytes in all)"));
   }
 }
 

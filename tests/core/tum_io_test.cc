@@ -17,6 +17,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/resource_limits.h"
 #include "tests/test_util.h"
 
 namespace mmh {
@@ -136,9 +137,11 @@ TEST(TumIo, RoundTripTimestampsAndTranslationsAreBitExact) {
   Trajectory trajectory = RandomTrajectory(500, 5);
   for (auto& pose : trajectory.poses) pose.rotation = Eigen::Quaterniond::Identity();
   trajectory.timestamps[0] = 0.1 + 0.2;  // 0.30000000000000004
+  // The extremes a reader accepts: the largest coordinate below kMaxTranslationMetres (every bit
+  // of the mantissa set), the smallest normal and the smallest subnormal.
   trajectory.poses[1].translation =
-      Eigen::Vector3d(std::numeric_limits<double>::max(), std::numeric_limits<double>::min(),
-                      std::numeric_limits<double>::denorm_min());
+      Eigen::Vector3d(std::nextafter(kMaxTranslationMetres, 0.0),
+                      std::numeric_limits<double>::min(), std::numeric_limits<double>::denorm_min());
   const fs::path path = dir / "t.tum";
   WriteTum(path, trajectory);
   ExpectBitIdentical(trajectory, ReadTum(path));
@@ -149,7 +152,7 @@ TEST(TumIo, WritesShortestRoundTripNumbers) {
   Trajectory trajectory;
   trajectory.timestamps = {0.1, 2.0};
   trajectory.poses = {Rigid3(Eigen::Quaterniond(1, 0, 0, 0), Eigen::Vector3d(0.1, 0.25, -3)),
-                      Rigid3(Eigen::Quaterniond(0, 0, 0, 1), Eigen::Vector3d(1e-9, 0, 1e21))};
+                      Rigid3(Eigen::Quaterniond(0, 0, 0, 1), Eigen::Vector3d(1e-9, 0, 1e6))};
   const fs::path path = dir / "short.tum";
   WriteTum(path, trajectory, "first line\nsecond line");
   const std::string text = ReadBytes(path);
@@ -157,7 +160,7 @@ TEST(TumIo, WritesShortestRoundTripNumbers) {
             "# first line\n"
             "# second line\n"
             "0.1 0.1 0.25 -3 0 0 0 1\n"
-            "2 1e-09 0 1e+21 0 0 1 0\n");
+            "2 1e-09 0 1e+06 0 0 1 0\n");
   // The comment lines are skipped when reading.
   ExpectBitIdentical(trajectory, ReadTum(path));
 }
@@ -426,6 +429,20 @@ TEST(TumIo, NonexistentPathIsRejected) {
   const std::string message = ReadTumError(path);
   EXPECT_THAT(message, HasSubstr(path.string()));
   EXPECT_THAT(message, HasSubstr("does not exist"));
+}
+
+// Coordinates beyond kMaxTranslationMetres (they overflowed the montage's costs) are refused
+// where they are read, naming the line and field; the limit itself is accepted.
+TEST(TumIo, TranslationsBeyondTheMeaningfulRangeAreRejected) {
+  TempDir dir;
+  for (const char* value : {"1e150", "1e200", "1e300", "-1000000.0001"}) {
+    std::ofstream(dir / "huge.tum") << "0 0 0 0 0 0 0 1\n0.1 0 " << value << " 0 0 0 0 1\n";
+    const std::string message = test_util::ErrorOf([&] { ReadTum(dir / "huge.tum"); });
+    EXPECT_THAT(message, HasSubstr("huge.tum:2, field ty: got '" + std::string(value) + "'"));
+    EXPECT_THAT(message, HasSubstr("expected a translation within +-1e6 m"));
+  }
+  std::ofstream(dir / "edge.tum") << "0 1e6 -1e6 1e6 0 0 0 1\n";
+  EXPECT_EQ(ReadTum(dir / "edge.tum").poses[0].translation.x(), 1e6);
 }
 
 TEST(TumIo, DirectoryInsteadOfFileIsRejected) {
