@@ -24,7 +24,8 @@ void AddCommonFlags(CLI::App* command, CommonFlags* flags, const CommonFlagsSpec
     if (spec.out_required) out->required();
   }
   if (spec.threads) {
-    command->add_option("--threads", flags->threads, "Worker threads (0: all cores)")
+    command
+        ->add_option("--threads", flags->threads, "Worker threads, 1 to 1024 (default: all cores)")
         ->check(CLI::NonNegativeNumber);
   }
   if (spec.quiet) command->add_flag("--quiet", flags->quiet, "Print nothing on success");

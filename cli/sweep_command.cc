@@ -161,7 +161,7 @@ void AddSweepCommand(CLI::App& app, const std::vector<std::string>& argv) {
                   "Override of every cell's base config: key.path=value, repeatable")
       ->take_all();
   cmd->add_option("--threads", args->common.threads,
-                  "Threads of all cells together (0: all cores); each job gets its share")
+                  "Threads of all cells together (default: all cores); each job gets its share")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--slurm-bin", args->slurm_bin, "Folder of sbatch/scontrol (default: PATH)");
   cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");

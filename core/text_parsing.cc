@@ -38,9 +38,10 @@ std::string NotText(std::string_view head) {
   return "binary data (a NUL byte at offset " + std::to_string(nul) + ")";
 }
 
-}  // namespace
-
-std::string ReadTextFile(const std::filesystem::path& path, std::size_t max_bytes) {
+// Reads a whole file in chunks up to `max_bytes` (a device or FIFO has no size to check first);
+// with `text_only`, the first chunk must not look like UTF-16/32 or binary data.
+std::string ReadBounded(const std::filesystem::path& path, std::size_t max_bytes,
+                        const std::string& expected, bool text_only) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     ThrowBadValue(path.string(), "a path that does not exist", "an existing, readable file");
@@ -53,21 +54,18 @@ std::string ReadTextFile(const std::filesystem::path& path, std::size_t max_byte
     ThrowBadValue(path.string(), "an unreadable file (" + std::string(std::strerror(errno)) + ")",
                   "a readable file");
   }
-  // Read in chunks up to the limit: a device or FIFO has no size to check first, and the first
-  // chunk already tells binary data from text.
-  std::string text;
+  std::string bytes;
   constexpr std::size_t kChunk = 1 << 16;
-  const std::string expected = "a UTF-8 text file";
   while (in) {
-    const std::size_t old_size = text.size();
-    text.resize(old_size + kChunk);
-    in.read(text.data() + old_size, kChunk);
-    text.resize(old_size + static_cast<std::size_t>(in.gcount()));
-    if (old_size == 0) {
-      const std::string what = NotText(text);
+    const std::size_t old_size = bytes.size();
+    bytes.resize(old_size + kChunk);
+    in.read(bytes.data() + old_size, kChunk);
+    bytes.resize(old_size + static_cast<std::size_t>(in.gcount()));
+    if (text_only && old_size == 0) {
+      const std::string what = NotText(bytes);
       if (!what.empty()) ThrowBadValue(path.string(), what, expected);
     }
-    if (text.size() > max_bytes) {
+    if (bytes.size() > max_bytes) {
       ThrowBadValue(path.string(), "more than " + FormatBytes(max_bytes),
                     expected + " of at most " + FormatBytes(max_bytes));
     }
@@ -76,6 +74,14 @@ std::string ReadTextFile(const std::filesystem::path& path, std::size_t max_byte
     ThrowBadValue(path.string(), "a read error (" + std::string(std::strerror(errno)) + ")",
                   "a readable file");
   }
+  return bytes;
+}
+
+}  // namespace
+
+std::string ReadTextFile(const std::filesystem::path& path, std::size_t max_bytes) {
+  const std::string expected = "a UTF-8 text file";
+  std::string text = ReadBounded(path, max_bytes, expected, /*text_only=*/true);
   const std::size_t nul = text.find('\0');
   if (nul != std::string::npos) {
     ThrowBadValue(path.string(), "binary data (a NUL byte at offset " + std::to_string(nul) + ")",
@@ -83,6 +89,10 @@ std::string ReadTextFile(const std::filesystem::path& path, std::size_t max_byte
   }
   if (text.starts_with("\xEF\xBB\xBF")) text.erase(0, 3);
   return text;
+}
+
+std::string ReadBinaryFile(const std::filesystem::path& path, std::size_t max_bytes) {
+  return ReadBounded(path, max_bytes, "a file", /*text_only=*/false);
 }
 
 std::vector<std::string_view> SplitFields(std::string_view line, std::string_view delimiters) {

@@ -19,6 +19,11 @@ inline constexpr std::size_t kMaxTextFileBytes = std::size_t{1} << 30;
 std::string ReadTextFile(const std::filesystem::path& path,
                          std::size_t max_bytes = kMaxTextFileBytes);
 
+// Reads a whole file of any content (a .glb, an image) with the same errors and size bound as
+// ReadTextFile, without the text checks.
+std::string ReadBinaryFile(const std::filesystem::path& path,
+                           std::size_t max_bytes = kMaxTextFileBytes);
+
 // Splits on any run of the given delimiter characters, dropping empty fields.
 std::vector<std::string_view> SplitFields(std::string_view line, std::string_view delimiters);
 

@@ -285,7 +285,7 @@ json MontageData(const MontageFolder& folder, const ReportOptions& options, std:
   }
   data["tables"].push_back({{"title", "Montage summary"}, {"file", "summary.json"},
                             {"columns", {"quantity", "value"}}, {"rows", rows}});
-  if (fs::exists(dir / "montage.glb")) *glb = ReadTextFile(dir / "montage.glb");
+  if (fs::exists(dir / "montage.glb")) *glb = ReadBinaryFile(dir / "montage.glb");
   return data;
 }
 

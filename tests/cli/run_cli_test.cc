@@ -66,6 +66,7 @@ TEST(RunCliTest, FailedTrackingKeepsTheFinishedStages) {
   TempDir dir;
   const auto r = RunMmh("run --config " + kSource + "/configs/soldier.json " + kStory +
                         "--set render.frames=20 --set run.takes=2 "
+                        "--set montage.labelling.min_segment_length=10 "
                         "--set tracker.verification.max_rms=1e-9 --quiet --out " +
                         (dir / "out").string());
   EXPECT_EQ(r.exit_code, 1) << r.output;

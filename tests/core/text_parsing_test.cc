@@ -243,6 +243,27 @@ TEST_F(TextFileTest, ReadTextFileErrorsNameThePath) {
   }
 }
 
+// A binary file (a .glb) is read whole, NUL bytes and all, with the same bound and path errors.
+TEST_F(TextFileTest, ReadBinaryFileReadsEveryByteAndKeepsTheBound) {
+  std::string bytes = "glTF";
+  bytes += std::string("\0\x02\0\0", 4);
+  bytes += std::string(70000, '\xFF');  // more than one read chunk
+  {
+    std::ofstream out(dir_ / "f.glb", std::ios::binary);
+    out << bytes;
+  }
+  EXPECT_EQ(ReadBinaryFile(dir_ / "f.glb"), bytes);
+  EXPECT_THROW(ReadTextFile(dir_ / "f.glb"), InputError);
+  try {
+    ReadBinaryFile(dir_ / "f.glb", 1000);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr((dir_ / "f.glb").string()));
+    EXPECT_THAT(e.what(), HasSubstr("more than"));
+  }
+  EXPECT_THROW(ReadBinaryFile(dir_ / "missing.glb"), InputError);
+}
+
 std::string ErrorReading(const fs::path& path, std::size_t max_bytes = kMaxTextFileBytes) {
   try {
     ReadTextFile(path, max_bytes);

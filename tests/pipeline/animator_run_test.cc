@@ -106,6 +106,8 @@ TEST(AnimatorRunTest, ATakeWhoseTrackingFailedIsNamedAndTheFinishedTakesAreRepor
   Config config;
   config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   config.Set("render.frames=20");
+  // Short takes must still be longer than the montage's shortest segment (checked up front).
+  config.Set("montage.labelling.min_segment_length=10");
   config.Set("run.takes=2");
   // No pose can pass verification: every frame is lost.
   config.Set("tracker.verification.max_rms=1e-9");
