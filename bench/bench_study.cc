@@ -88,7 +88,7 @@ void BM_ScoringAndAnalysis(benchmark::State& state) {
     const auto design = mmh::study::DrawScoringDesign(options, 20, 3, seed);
     mmh::study::StudyData data;
     data.comparisons = mmh::study::JudgeComparisons(design, appeals, {}, seed);
-    data.rankings = mmh::study::RankOwnAnimations(appeals, {}, seed);
+    data.rankings = mmh::study::RankOwnAnimations(appeals, {}, {}, seed);
     const auto analysis = mmh::study::AnalyzeStudy(data);
     benchmark::DoNotOptimize(analysis.h1.mean_m);
     ++seed;

@@ -72,6 +72,11 @@ void CheckResumable(const std::filesystem::path& out, const nlohmann::json& reso
 pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animator,
                                   const std::filesystem::path& out, bool progress_bar,
                                   const std::vector<std::string>& argv, int threads, bool resume) {
+  if (!config.run.metrics) {
+    ThrowBadValue("run.metrics", "false",
+                  "true: mmh run and mmh regress write metrics.json (false is for the replicates "
+                  "of mmh study and mmh calibrate)");
+  }
   const nlohmann::json resolved = config.ToJson();
   if (resume) CheckResumable(out, resolved);
   EnsureDirectory(out);

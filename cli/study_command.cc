@@ -74,7 +74,9 @@ nlohmann::json AnimatorJson(const study::AnimatorOutcome& a) {
             {"unconstrained_cost", a.montage_summary.unconstrained_cost},
             {"constraint_increase_percent", a.montage_summary.constraint_increase_percent},
             {"unconstrained_short_segments", a.montage_summary.unconstrained_short_segments}}},
-          {"truth_montage_appeal", a.truth_montage_appeal.appeal},
+          {"truth_montage_appeal", a.truth_montage_appeal
+                                       ? nlohmann::json(a.truth_montage_appeal->appeal)
+                                       : nlohmann::json(nullptr)},
           {"rendered_frames", a.rendered_frames},
           {"metrics", a.metrics}};
 }
@@ -253,7 +255,7 @@ void AddStudyCommand(CLI::App& app, const std::vector<std::string>& argv) {
       "study", "The paper's user study on simulated animators and scorers through the pipeline");
   AddCommonFlags(cmd, &args->common,
                  {.config_help = "JSON config (configs/study_soldier.json): the run sections and "
-                                 "study, scorers, viewer"});
+                                 "study, scorers, viewer, self_appraisal"});
   cmd->add_option("--replicates", args->replicates,
                   "Independent studies (power of each test); overrides study.replicates")
       ->check(CLI::PositiveNumber);

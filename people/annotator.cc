@@ -41,6 +41,11 @@ void AnnotatorProfile::Validate(const std::string& prefix) const {
   RequirePositive(max_speed, prefix + ".max_speed", "slider units/s");
   RequireNonNegative(tremor, prefix + ".tremor");
   RequireNonNegative(lapse_rate, prefix + ".lapse_rate", "1/min");
+  RequireFinite(move_threshold, prefix + ".move_threshold");
+  if (!(move_threshold >= 0.0 && move_threshold <= 2 * kSliderLimit)) {
+    ThrowBadValue(prefix + ".move_threshold", FormatNumber(move_threshold),
+                  "a slider distance in [0, 10]");
+  }
   RequirePositive(lapse_seconds, prefix + ".lapse_seconds", "s");
 }
 
@@ -147,7 +152,8 @@ AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorP
   for (int i = 0; i < n; ++i) {
     if (!lapsed[i]) {
       const double seen = i - session.delay[i] * fps;  // the frame whose judgement arrives now
-      target = seen < 0 ? options.start_value : Sample(aim, seen);
+      const double wanted = seen < 0 ? options.start_value : Sample(aim, seen);
+      if (std::abs(wanted - target) > profile.move_threshold) target = wanted;
     }
     for (int s = 0; s < options.substeps; ++s) {
       // Semi-implicit Euler: stable for ω·h << 1 (h = 4 ms at the defaults).

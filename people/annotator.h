@@ -7,7 +7,12 @@
 //   judgement  j(t) = 5·tanh(g·(q(t) − θ)/5) + σ_o·n(t), n an AR(1) process of unit variance and
 //                     time constant τ_o (a slowly drifting opinion);
 //   target     r(t) = j(t − d(t)), the reaction delay d(t) = d̄ + δ·w(t) varying slowly
-//                     (w in [−1, 1]); held during lapses of attention (Poisson, rate λ);
+//                     (w in [−1, 1]); held during lapses of attention (Poisson, rate λ), and
+//                     held while |j(t − d(t)) − r| ≤ h: the hand moves the block only when the
+//                     opinion has left it by more than h (intermittent control: people correct
+//                     in discrete moves, not continuously; Craik 1947, Loram et al. 2011). With
+//                     h > 0 the block dwells at a few positions, the paper's "three discrete
+//                     levels" on "a continuous scale";
 //   hand       x'' = ω²(r − x) − 2ω·x' (critically damped: smooth, no overshoot), |x'| ≤ v_max,
 //                     end stops at ±5, plus tremor; its lag at low frequencies is 2/ω.
 // So the slider lags the judgement by about d̄ + 2/ω (0.3 s + 0.1 s at the defaults; the paper's
@@ -37,6 +42,7 @@ struct AnnotatorProfile {
   double tremor = 0.05;           // [slider units] RMS hand tremor on the block
   double lapse_rate = 1.0;        // λ [lapses per minute]
   double lapse_seconds = 1.5;     // [s] mean length of a lapse
+  double move_threshold = 0.0;    // h [slider units]: opinion change that makes the hand move
 
   template <class V>
   void VisitFields(V& v) {
@@ -50,6 +56,7 @@ struct AnnotatorProfile {
     v("tremor", tremor);
     v("lapse_rate", lapse_rate);
     v("lapse_seconds", lapse_seconds);
+    v("move_threshold", move_threshold);
   }
   void Validate(const std::string& prefix) const;
 };

@@ -25,7 +25,9 @@ void PopulationOptions::Validate(const std::string& prefix) const {
                                  {taste_gain_sd, "taste_gain_sd"},
                                  {opinion_noise_sd, "opinion_noise_sd"},
                                  {opinion_noise_mean, "opinion_noise_mean"},
-                                 {lapse_rate, "lapse_rate"}}) {
+                                 {lapse_rate, "lapse_rate"},
+                                 {move_threshold_mean, "move_threshold_mean"},
+                                 {move_threshold_sd, "move_threshold_sd"}}) {
     RequireNonNegative(sd, prefix + "." + name);
   }
   if (!(delay_mean >= 0.25 && delay_mean <= 0.35)) {
@@ -63,6 +65,9 @@ Participant DrawParticipant(const PopulationOptions& p, int index) {
   n.taste_gain = std::max(1.0, random.Normal(p.taste_gain_mean, p.taste_gain_sd));
   n.opinion_noise = std::max(0.0, random.Normal(p.opinion_noise_mean, p.opinion_noise_sd));
   n.lapse_rate = p.lapse_rate;
+  // Drawn last, so that adding it left every earlier draw (and participant) as it was.
+  n.move_threshold = std::clamp(random.Normal(p.move_threshold_mean, p.move_threshold_sd), 0.0,
+                                10.0);  // the box spans 10 slider units
   return participant;
 }
 

@@ -31,6 +31,9 @@ struct PopulationOptions {
   double opinion_noise_mean = 0.6;
   double opinion_noise_sd = 0.2;
   double lapse_rate = 1.0;  // [1/min]
+  // The annotators' dead band h (people/annotator.h), normal truncated at 0 [slider units].
+  double move_threshold_mean = 0.0;
+  double move_threshold_sd = 0.0;
 
   template <class V>
   void VisitFields(V& v) {
@@ -52,6 +55,8 @@ struct PopulationOptions {
     v("opinion_noise_mean", opinion_noise_mean);
     v("opinion_noise_sd", opinion_noise_sd);
     v("lapse_rate", lapse_rate);
+    v("move_threshold_mean", move_threshold_mean);
+    v("move_threshold_sd", move_threshold_sd);
   }
   void Validate(const std::string& prefix) const;
 };

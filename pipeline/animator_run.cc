@@ -457,16 +457,20 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     names.push_back("take " + std::to_string(t.take));
   }
   result.montage = montage::Compose(tracked, read, config.montage, names);
-  result.truth_montage = montage::Compose(truth, truth_annotations, config.montage, names);
   result.montage_quality = MontageQuality(result.montage, result.takes);
-  result.truth_montage_quality = MontageQuality(result.truth_montage, result.takes);
+  if (options.metrics) {
+    result.truth_montage = montage::Compose(truth, truth_annotations, config.montage, names);
+    result.truth_montage_quality = MontageQuality(result.truth_montage, result.takes);
+  }
   result.seconds.compose = SecondsSince(t0);
 
   // metrics.json holds no timings (same config and seed, same bytes); they go to run.json.
-  t0 = Clock::now();
-  result.metrics =
-      ComputeRunMetrics(config, result, models[0], practice_takes ? &models[1] : nullptr);
-  result.seconds.metrics = SecondsSince(t0);
+  if (options.metrics) {
+    t0 = Clock::now();
+    result.metrics =
+        ComputeRunMetrics(config, result, models[0], practice_takes ? &models[1] : nullptr);
+    result.seconds.metrics = SecondsSince(t0);
+  }
   result.seconds.total = SecondsSince(start);
   return result;
 }

@@ -54,6 +54,10 @@ struct RunOptions {
   // (slerp and lerp; the first or last estimate held at the ends). A take with fewer than
   // min_tracked_share of its frames estimated is a failed take (InputError-like RunError).
   double min_tracked_share = 0.5;
+  // Compute metrics.json (per-frame pose errors with ADD/ADD-S, annotation errors, the montage
+  // against the ground truth's montage, which is composed only for it). The study's statistics
+  // never read them: `mmh study` computes them for replicate 0 only, `mmh calibrate` never.
+  bool metrics = true;
 
   template <class V>
   void VisitFields(V& v) {
@@ -61,6 +65,7 @@ struct RunOptions {
     v("practice", practice);
     v("fidelity", fidelity);
     v("min_tracked_share", min_tracked_share);
+    v("metrics", metrics);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -119,13 +124,13 @@ struct AnimatorRun {
   std::optional<TakeRun> practice;
   std::vector<TakeRun> takes;
   montage::Montage montage;        // from the tracked takes and read annotations
-  montage::Montage truth_montage;  // from the ground truth
+  montage::Montage truth_montage;  // from the ground truth (empty unless run.metrics)
   TriangleMesh proxy_model;        // the takes' proxy (montage.glb shows it)
   // Latent quality of each montage frame, carried from the takes' frames it shows
   // (sim::CompositeQuality).
   std::vector<double> montage_quality;
   std::vector<double> truth_montage_quality;
-  nlohmann::json metrics;  // metrics.json (see pipeline/run_metrics.h)
+  nlohmann::json metrics;  // metrics.json (see pipeline/run_metrics.h); null unless run.metrics
   StageSeconds seconds;
   int rendered_frames = 0;  // frames rendered and tracked or read (0 in fast fidelity)
 };

@@ -157,7 +157,7 @@ void RenderOptions::Validate(const std::string& prefix) const {
 
 RenderConfig RenderConfig::FromConfig(const Config& config) {
   config.RequireOnlySections({"render", "camera", "scene", "hand", "sensor", "motion", "population",
-                              "performance", "annotator", "viewer", "study", "scorers", "montage",
+                              "performance", "annotator", "viewer", "self_appraisal", "study", "scorers", "montage",
                               "track", "metrics", "run", "tracker", "slider", "error_model"});
   RenderConfig c;
   c.render = config.Get<RenderOptions>("render");

@@ -196,7 +196,9 @@ std::vector<ComparisonRow> JudgeComparisons(const ScoringDesign& design,
 }
 
 std::vector<RankingRow> RankOwnAnimations(const std::vector<AnimationAppeals>& appeals,
-                                          const sim::ViewerOptions& viewer, std::uint64_t seed) {
+                                          const sim::ViewerOptions& viewer,
+                                          const sim::SelfAppraisalOptions& self_appraisal,
+                                          std::uint64_t seed) {
   const std::uint64_t ranking_seed = sim::DeriveSeed(seed, {kRankingStream});
   std::vector<RankingRow> rows;
   for (int i = 0; i < static_cast<int>(appeals.size()); ++i) {
@@ -209,7 +211,8 @@ std::vector<RankingRow> RankOwnAnimations(const std::vector<AnimationAppeals>& a
       utility[item] = sim::Utility(
           appeal, person, viewer, seed,
           sim::DeriveSeed(ranking_seed,
-                          {static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(item)}));
+                          {static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(item)})) +
+          sim::SelfAppraisalBias(self_appraisal, item, takes);
     }
     std::vector<int> order(takes + 1);
     std::iota(order.begin(), order.end(), 0);

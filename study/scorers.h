@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "people/self_appraisal.h"
 #include "people/viewer.h"
 #include "study/study_data.h"
 
@@ -83,9 +84,12 @@ std::vector<ComparisonRow> JudgeComparisons(const ScoringDesign& design,
                                             const std::vector<AnimationAppeals>& appeals,
                                             const sim::ViewerOptions& viewer, std::uint64_t seed);
 
-// Each animator ranks their own takes and montage by their utility in one viewing each (1 = the
-// highest). Same viewers and seed as JudgeComparisons.
+// Each animator ranks their own takes and montage by their utility in one viewing each plus the
+// self-appraisal biases (people/self_appraisal.h), 1 = the highest. Same viewers and seed as
+// JudgeComparisons.
 std::vector<RankingRow> RankOwnAnimations(const std::vector<AnimationAppeals>& appeals,
-                                          const sim::ViewerOptions& viewer, std::uint64_t seed);
+                                          const sim::ViewerOptions& viewer,
+                                          const sim::SelfAppraisalOptions& self_appraisal,
+                                          std::uint64_t seed);
 
 }  // namespace mmh::study

@@ -13,6 +13,7 @@
 #include "core/resource_limits.h"
 #include "people/random.h"
 #include "stats/binomial_test.h"
+#include "stats/descriptive.h"
 
 namespace mmh::study {
 namespace {
@@ -43,8 +44,10 @@ AnimatorOutcome Summarise(const StudyConfig& config, int index, pipeline::Animat
         config.viewer));
   }
   out.montage_appeal = sim::Appraise(run.montage.trajectory, run.montage_quality, config.viewer);
-  out.truth_montage_appeal =
-      sim::Appraise(run.truth_montage.trajectory, run.truth_montage_quality, config.viewer);
+  if (config.run.run.metrics) {
+    out.truth_montage_appeal =
+        sim::Appraise(run.truth_montage.trajectory, run.truth_montage_quality, config.viewer);
+  }
   for (const auto& segment : run.montage.segments) out.montage_takes.push_back(segment.take);
   out.montage_summary = run.montage.summary;
   out.metrics = std::move(run.metrics);
@@ -81,10 +84,11 @@ void SimulatedStudyOptions::Validate(const std::string& prefix) const {
 
 StudyConfig StudyConfig::FromConfig(const Config& config) {
   StudyConfig out;
-  out.run = pipeline::RunConfig::FromConfig(config, {"study", "scorers", "viewer"});
+  out.run = pipeline::RunConfig::FromConfig(config, {"study", "scorers", "viewer", "self_appraisal"});
   out.study = config.Get<SimulatedStudyOptions>("study");
   out.scorers = config.Get<ScorerOptions>("scorers");
   out.viewer = config.Get<sim::ViewerOptions>("viewer");
+  out.self_appraisal = config.Get<sim::SelfAppraisalOptions>("self_appraisal");
   // Checked here so that a bad design fails before any animator runs.
   ScorerCount(out.scorers, out.study.animators, out.run.run.takes);
   return out;
@@ -95,6 +99,7 @@ nlohmann::json StudyConfig::ToJson() const {
   j["study"] = mmh::ToJson(study);
   j["scorers"] = mmh::ToJson(scorers);
   j["viewer"] = mmh::ToJson(viewer);
+  j["self_appraisal"] = mmh::ToJson(self_appraisal);
   return j;
 }
 
@@ -105,6 +110,8 @@ StudyConfig StudyConfig::ForReplicate(int replicate) const {
   out.run.render.population.seed =
       sim::DeriveSeed(run.render.population.seed, {kReplicatePopulation, r});
   out.study.seed = sim::DeriveSeed(study.seed, {kReplicateScoring, r});
+  // Only replicate 0's animators are written out (results.json, animators.csv).
+  out.run.run.metrics = false;
   return out;
 }
 
@@ -120,14 +127,17 @@ StudyData ScoreStudy(const StudyConfig& config, const std::vector<AnimatorOutcom
   }
   StudyData data;
   data.comparisons = JudgeComparisons(*design, appeals, config.viewer, config.study.seed);
-  data.rankings = RankOwnAnimations(appeals, config.viewer, config.study.seed);
+  data.rankings =
+      RankOwnAnimations(appeals, config.viewer, config.self_appraisal, config.study.seed);
   for (const AnimatorOutcome& a : animators) {
     const auto& s = a.montage_summary;
     // The compositor's costs as they are (negative where takes are liked: C_d = -a'(t)); the
     // constrained optimum cannot be below the unconstrained one (rounding aside).
-    data.segment_costs.push_back({a.id, s.unconstrained_cost,
-                                  std::max(s.total_cost, s.unconstrained_cost),
-                                  s.unconstrained_short_segments, 0});
+    data.segment_costs.push_back({.animator = a.id,
+                                  .cost_unconstrained = s.unconstrained_cost,
+                                  .cost_constrained = std::max(s.total_cost, s.unconstrained_cost),
+                                  .short_segments_unconstrained = s.unconstrained_short_segments,
+                                  .reference_frames = s.reference_frames});
   }
   return data;
 }
@@ -135,6 +145,7 @@ StudyData ScoreStudy(const StudyConfig& config, const std::vector<AnimatorOutcom
 SimulatedStudy RunSimulatedStudy(const StudyConfig& config, int replicate,
                                  const StudyProgress& progress) {
   config.study.Validate("study");
+  config.self_appraisal.Validate("self_appraisal");
   SimulatedStudy study;
   study.config = config;
   study.replicate = replicate;
@@ -247,35 +258,56 @@ nlohmann::json ToJson(const PowerEstimate& p) {
           {"paper_significant", p.paper_significant}};
 }
 
+std::vector<ReplicateStatistic> ReplicateStatistics(const StudyAnalysis& a) {
+  std::vector<ReplicateStatistic> out;
+  auto add = [&](const char* name, bool present, double value) {
+    out.push_back({name, present ? std::optional<double>(value) : std::nullopt});
+  };
+  const auto& friedman = a.rankings.friedman.result;
+  add("friedman_chi_squared", friedman.has_value(), friedman ? friedman->statistic : 0);
+  add("h1_mean_m", true, a.h1.mean_m);
+  add("h1_sd_m", true, a.h1.sd_m);
+  const auto& h1 = a.h1.t_test.result;
+  add("h1_t", h1.has_value(), h1 ? h1->t : 0);
+  add("h1_wins", true, static_cast<double>(a.h1.wins));
+  const auto& h2 = a.h2.t_test.result;
+  add("h2_mean_b", h2.has_value(), h2 ? h2->mean : 0);
+  add("h2_t", h2.has_value(), h2 ? h2->t : 0);
+  const auto& h3 = a.h3.mixed_model.result;
+  add("h3_f", h3.has_value(), h3 ? h3->take_test.f : 0);
+  // H2's b_i: sd and how many above chance (the paper: sd 0.126, 18 of 20).
+  std::vector<double> b;
+  for (const auto& [animator, value] : a.h2.b) b.push_back(value);
+  add("h2_sd_b", b.size() > 1, b.size() > 1 ? std::sqrt(stats::Variance(b)) : 0);
+  add("h2_above_chance", true,
+      static_cast<double>(std::count_if(b.begin(), b.end(), [&](double v) {
+        return v > a.options.all_takes_chance;
+      })));
+  const auto& segments = a.segment_constraint;
+  add("quick_transitions", segments.has_value(),
+      segments ? static_cast<double>(segments->animators_with_short_segments) : 0);
+  add("max_increase_percent", segments.has_value(), segments ? segments->max_increase_percent : 0);
+  add("max_paper_scale_percent", segments && segments->max_paper_scale_percent,
+      segments ? segments->max_paper_scale_percent.value_or(0) : 0);
+  for (const HypothesisTest& test : StudyHypotheses()) {
+    out.push_back({"p_" + test.id, test.p_value(a)});
+  }
+  return out;
+}
+
 std::string ReplicatesCsvHeader() {
-  std::string header =
-      "replicate,friedman_chi_squared,h1_mean_m,h1_sd_m,h1_t,h1_wins,h2_mean_b,h2_t,h3_f";
-  for (const HypothesisTest& test : StudyHypotheses()) header += ",p_" + test.id;
+  std::string header = "replicate";
+  for (const ReplicateStatistic& s : ReplicateStatistics(StudyAnalysis{})) header += "," + s.name;
   return header + "\n";
 }
 
-std::string ReplicateCsvRow(int replicate, const StudyAnalysis& a) {
-  std::ostringstream row;
-  auto opt = [&](bool present, double value) {
-    row << ',';
-    if (present) row << Num(value);
-  };
-  row << replicate;
-  opt(a.rankings.friedman.result.has_value(),
-      a.rankings.friedman.result ? a.rankings.friedman.result->statistic : 0);
-  row << ',' << Num(a.h1.mean_m) << ',' << Num(a.h1.sd_m);
-  opt(a.h1.t_test.result.has_value(), a.h1.t_test.result ? a.h1.t_test.result->t : 0);
-  row << ',' << a.h1.wins;
-  opt(a.h2.t_test.result.has_value(), a.h2.t_test.result ? a.h2.t_test.result->mean : 0);
-  opt(a.h2.t_test.result.has_value(), a.h2.t_test.result ? a.h2.t_test.result->t : 0);
-  opt(a.h3.mixed_model.result.has_value(),
-      a.h3.mixed_model.result ? a.h3.mixed_model.result->take_test.f : 0);
-  for (const HypothesisTest& test : StudyHypotheses()) {
-    const auto p = test.p_value(a);
-    opt(p.has_value(), p.value_or(0));
+std::string ReplicateCsvRow(int replicate, const StudyAnalysis& analysis) {
+  std::string row = std::to_string(replicate);
+  for (const ReplicateStatistic& s : ReplicateStatistics(analysis)) {
+    row += ",";
+    if (s.value) row += Num(*s.value);
   }
-  row << '\n';
-  return row.str();
+  return row + "\n";
 }
 
 std::string AnimatorsCsv(const std::vector<AnimatorOutcome>& animators) {
@@ -297,7 +329,8 @@ std::string AnimatorsCsv(const std::vector<AnimatorOutcome>& animators) {
     }
     const auto& s = a.montage_summary;
     out << ',' << Num(a.montage_appeal.mean_quality) << ',' << Num(a.montage_appeal.appeal) << ','
-        << Num(a.montage_appeal.artefacts_per_minute) << ',' << Num(a.truth_montage_appeal.appeal)
+        << Num(a.montage_appeal.artefacts_per_minute) << ','
+        << (a.truth_montage_appeal ? Num(a.truth_montage_appeal->appeal) : std::string("NA"))
         << ',' << a.montage_takes.size() << ',' << Num(s.total_cost) << ','
         << Num(s.unconstrained_cost) << ',' << Num(s.constraint_increase_percent) << ','
         << s.unconstrained_short_segments << ',' << a.rendered_frames << '\n';

@@ -58,12 +58,13 @@ struct SimulatedStudyOptions {
 };
 
 // Everything a simulated study reads: the run sections (pipeline::RunConfig) and "study",
-// "scorers", "viewer".
+// "scorers", "viewer", "self_appraisal".
 struct StudyConfig {
   pipeline::RunConfig run;
   SimulatedStudyOptions study;
   ScorerOptions scorers;
   sim::ViewerOptions viewer;
+  sim::SelfAppraisalOptions self_appraisal;
 
   static StudyConfig FromConfig(const Config& config);
   nlohmann::json ToJson() const;
@@ -80,7 +81,8 @@ struct AnimatorOutcome {
   std::vector<double> take_quality;      // mean latent quality of each take
   std::vector<sim::Appeal> take_appeal;  // each tracked take as viewers see it
   sim::Appeal montage_appeal;            // the montage of the tracked takes
-  sim::Appeal truth_montage_appeal;      // the montage of the ground truth, for comparison
+  // The montage of the ground truth, for comparison (run.metrics only).
+  std::optional<sim::Appeal> truth_montage_appeal;
   std::vector<int> montage_takes;        // take of each montage segment
   montage::ComposeSummary montage_summary;
   nlohmann::json metrics;  // the run's metrics.json
@@ -145,6 +147,16 @@ struct PowerEstimate {
 std::vector<PowerEstimate> EstimatePower(const std::vector<StudyAnalysis>& analyses, double alpha,
                                          double conf_level);
 nlohmann::json ToJson(const PowerEstimate& power);
+
+// The main statistics and p-values of one replicate, in the columns of replicates.csv:
+// friedman_chi_squared, h1_mean_m, h1_sd_m, h1_t, h1_wins, h2_mean_b, h2_t, h3_f, h2_sd_b,
+// h2_above_chance, quick_transitions, max_increase_percent, max_paper_scale_percent, then
+// p_<id> for every StudyHypotheses() test. nullopt: not computed in this replicate.
+struct ReplicateStatistic {
+  std::string name;
+  std::optional<double> value;
+};
+std::vector<ReplicateStatistic> ReplicateStatistics(const StudyAnalysis& analysis);
 
 // One row per replicate: the main statistics and p-values (replicates.csv), with header.
 std::string ReplicatesCsvHeader();

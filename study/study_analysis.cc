@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/annotation.h"
 #include "core/error.h"
 #include "core/options.h"
 #include "stats/descriptive.h"
@@ -185,15 +186,28 @@ nlohmann::json StudySummary::ToJson() const {
 nlohmann::json SegmentConstraintAnalysis::ToJson() const {
   nlohmann::json per = nlohmann::json::array();
   for (const auto& a : animators) {
+    auto opt = [](const std::optional<double>& v) {
+      return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+    };
     per.push_back({{"animator", a.animator},
+                   {"increase", a.increase},
                    {"increase_percent", a.increase_percent},
+                   {"paper_scale_percent", opt(a.paper_scale_percent)},
+                   {"increase_per_frame", opt(a.increase_per_frame)},
                    {"short_segments_unconstrained", a.short_segments_unconstrained}});
   }
+  auto opt = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+  };
   return {{"animators", per},
           {"animators_with_short_segments", animators_with_short_segments},
           {"max_increase_percent", max_increase_percent},
           {"mean_increase_percent", mean_increase_percent},
-          {"all_below_threshold", all_below_threshold}};
+          {"max_paper_scale_percent", opt(max_paper_scale_percent)},
+          {"mean_paper_scale_percent", opt(mean_paper_scale_percent)},
+          {"max_increase_per_frame", opt(max_increase_per_frame)},
+          {"all_below_threshold", all_below_threshold},
+          {"threshold_scale", threshold_scale}};
 }
 
 StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& options) {
@@ -364,28 +378,55 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
   // ---- Segment Length Constraint ----
   if (!data.segment_costs.empty()) {
     SegmentConstraintAnalysis s;
-    double sum = 0.0;
+    double sum = 0.0, paper_sum = 0.0;
+    bool paper_scale = true;  // every animator with short segments has reference_frames
+    bool relative_below = true, paper_below = true;
+    double paper_max = 0.0, per_frame_max = 0.0;
     for (const auto& row : data.segment_costs) {
       SegmentConstraintAnalysis::Animator an;
       an.animator = row.animator;
       an.short_segments_unconstrained = row.short_segments_unconstrained;
+      an.increase = row.cost_constrained - row.cost_unconstrained;
       an.increase_percent = row.cost_unconstrained == 0.0
                                 ? 0.0
-                                : 100.0 * (row.cost_constrained - row.cost_unconstrained) /
-                                      std::abs(row.cost_unconstrained);
+                                : 100.0 * an.increase / std::abs(row.cost_unconstrained);
+      if (row.reference_frames > 0) {
+        const double n = row.reference_frames;
+        const double shifted = row.cost_unconstrained + kMaxAnnotation * n;
+        if (shifted > 0) an.paper_scale_percent = 100.0 * an.increase / shifted;
+        an.increase_per_frame = an.increase / n;
+      }
       if (an.short_segments_unconstrained > 0) {
         ++s.animators_with_short_segments;
         s.max_increase_percent = std::max(s.max_increase_percent, an.increase_percent);
         sum += an.increase_percent;
-        s.all_below_threshold =
-            s.all_below_threshold && an.increase_percent < options.cost_increase_threshold_percent;
+        relative_below =
+            relative_below && an.increase_percent < options.cost_increase_threshold_percent;
+        if (an.paper_scale_percent) {
+          paper_max = std::max(paper_max, *an.paper_scale_percent);
+          per_frame_max = std::max(per_frame_max, *an.increase_per_frame);
+          paper_sum += *an.paper_scale_percent;
+          paper_below =
+              paper_below && *an.paper_scale_percent < options.cost_increase_threshold_percent;
+        } else {
+          paper_scale = false;
+        }
       }
       s.animators.push_back(an);
     }
     std::sort(s.animators.begin(), s.animators.end(),
               [](const auto& x, const auto& y) { return x.animator < y.animator; });
-    s.mean_increase_percent =
-        s.animators_with_short_segments ? sum / s.animators_with_short_segments : 0.0;
+    const std::size_t k = s.animators_with_short_segments;
+    s.mean_increase_percent = k ? sum / k : 0.0;
+    if (paper_scale) {
+      s.max_paper_scale_percent = paper_max;
+      s.mean_paper_scale_percent = k ? paper_sum / k : 0.0;
+      s.max_increase_per_frame = per_frame_max;
+      s.all_below_threshold = paper_below;
+      s.threshold_scale = "paper";
+    } else {
+      s.all_below_threshold = relative_below;
+    }
     a.segment_constraint = s;
   }
   return a;
@@ -550,9 +591,16 @@ std::string StudyAnalysis::Report() const {
     const auto& s = *segment_constraint;
     out << "segments: " << s.animators_with_short_segments << " of " << s.animators.size()
         << " montages had short segments without the constraint; cost increase max "
-        << Short(s.max_increase_percent) << " %, mean " << Short(s.mean_increase_percent) << " % ("
-        << (s.all_below_threshold ? "all" : "not all") << " below "
-        << Short(options.cost_increase_threshold_percent) << " %)\n";
+        << Short(s.max_increase_percent) << " %, mean " << Short(s.mean_increase_percent)
+        << " % of |C0|";
+    if (s.max_paper_scale_percent) {
+      out << "; on the paper's scale (C_d = 5 - a') max " << Short(*s.max_paper_scale_percent)
+          << " %, mean " << Short(*s.mean_paper_scale_percent) << " %, at most "
+          << Short(*s.max_increase_per_frame) << " slider units per frame";
+    }
+    out << " (" << (s.all_below_threshold ? "all" : "not all") << " below "
+        << Short(options.cost_increase_threshold_percent) << " %"
+        << (s.threshold_scale == "paper" ? " on the paper's scale" : " of |C0|") << ")\n";
   }
   for (const auto& w : summary.warnings) out << "warning: " << w << "\n";
   return out.str();

@@ -137,17 +137,35 @@ struct H3Analysis {
   std::vector<double> take_standard_errors;
 };
 
+// The constraint's cost increase C − C0 (eq. 7 with d = 60 against d = 0) on three scales. The
+// compositor's data cost C_d = −a'(t) (eq. 8) is negative where a take is liked, so C0 can be near
+// 0 and 100 (C − C0) / |C0| is ill-conditioned. A percentage needs a cost whose zero means "no
+// cost": shifting C_d by the slider's maximum, 5 − a'(t) ≥ 0 for an unwarped annotation, changes
+// no optimum (a constant n·5 over the n reference frames) and makes C_T the distance from an
+// all-liked montage plus the transitions' cost. "< 1 %" is read on that scale (the paper's scale):
+//   paper_scale_percent = 100 (C − C0) / (C0 + 5 n),
+// beside the absolute increase per reference frame, (C − C0) / n, in slider units.
 struct SegmentConstraintAnalysis {
   struct Animator {
     std::string animator;
-    double increase_percent = 0.0;  // 100 (C - C0) / |C0| (0 when C0 = 0)
+    double increase = 0.0;          // C − C0
+    double increase_percent = 0.0;  // 100 (C − C0) / |C0| (0 when C0 = 0)
+    std::optional<double> paper_scale_percent;  // needs reference_frames
+    std::optional<double> increase_per_frame;   // (C − C0) / n, slider units
     int short_segments_unconstrained = 0;
   };
   std::vector<Animator> animators;
   std::size_t animators_with_short_segments = 0;  // "quick transitions" without the constraint
   double max_increase_percent = 0.0;              // among those
   double mean_increase_percent = 0.0;             // among those (0 if none)
+  // Among those, when every one has reference_frames.
+  std::optional<double> max_paper_scale_percent;
+  std::optional<double> mean_paper_scale_percent;
+  std::optional<double> max_increase_per_frame;
+  // Every increase among those below options.cost_increase_threshold_percent: on the paper's
+  // scale when known, else relative to |C0| (`threshold_scale` says which).
   bool all_below_threshold = true;
+  std::string threshold_scale = "relative_to_abs_c0";
 
   nlohmann::json ToJson() const;
 };

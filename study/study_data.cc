@@ -1,5 +1,6 @@
 #include "study/study_data.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <map>
@@ -15,12 +16,15 @@
 namespace mmh::study {
 namespace {
 
-// A CSV file with a header row: the columns are found by name (any order); a missing or unknown
-// column is an error. Blank lines and lines starting with '#' are skipped.
+// A CSV file with a header row: the columns are found by name (any order); a missing required
+// or an unknown column is an error; `optional` columns may be absent (their fields are then
+// empty). Blank lines and lines starting with '#' are skipped.
 class CsvTable {
  public:
-  CsvTable(const std::filesystem::path& path, const std::vector<std::string>& columns)
-      : source_(path.string()) {
+  CsvTable(const std::filesystem::path& path, std::vector<std::string> columns,
+           const std::vector<std::string>& optional = {})
+      : source_(path.string()), required_(columns.size()) {
+    columns.insert(columns.end(), optional.begin(), optional.end());
     const std::string text = ReadTextFile(path);
     std::istringstream lines(text);
     std::string line;
@@ -36,15 +40,15 @@ class CsvTable {
         header_seen = true;
         continue;
       }
-      if (fields.size() != columns.size()) {
+      if (fields.size() != header_.size()) {
         ThrowBadValue(source_ + ":" + std::to_string(number),
                       std::to_string(fields.size()) + " fields ('" + std::string(content) + "')",
-                      std::to_string(columns.size()) + " fields: " + Join(header_));
+                      std::to_string(header_.size()) + " fields: " + Join(header_));
       }
       Row row;
       row.line = number;
       row.fields.resize(columns.size());
-      for (std::size_t c = 0; c < columns.size(); ++c) {
+      for (std::size_t c = 0; c < header_.size(); ++c) {
         const std::string field(fields[c]);
         if (!field.empty() && (field.front() == '"' || field.front() == '\'')) {
           ThrowBadValue(Where(number, header_[c]), "'" + field + "'",
@@ -64,6 +68,9 @@ class CsvTable {
     std::vector<std::string> fields;  // in the order of the requested columns
   };
   const std::vector<Row>& rows() const { return rows_; }
+  bool Has(const std::string& column) const {
+    return std::find(header_.begin(), header_.end(), column) != header_.end();
+  }
   const std::string& source() const { return source_; }
 
   std::string Where(int line, const std::string& column) const {
@@ -95,7 +102,8 @@ class CsvTable {
       header_.push_back(name);
       index_of_.push_back(found);
     }
-    for (const auto& c : columns) {
+    for (std::size_t k = 0; k < required_; ++k) {
+      const std::string& c = columns[k];
       if (!seen.count(c)) {
         ThrowBadValue(where, "the header '" + content + "' without the column '" + c + "'",
                       "the columns " + Join(columns) + " (in any order)");
@@ -104,6 +112,7 @@ class CsvTable {
   }
 
   std::string source_;
+  std::size_t required_ = 0;           // the first required_ columns must be present
   std::vector<std::string> header_;    // column names in file order
   std::vector<std::size_t> index_of_;  // file column -> requested column
   std::vector<Row> rows_;
@@ -204,7 +213,8 @@ StudyData ReadStudyData(const std::filesystem::path& dir, const StudyDataOptions
   if (std::filesystem::exists(dir / kSegmentCostsFile, ec)) {
     const CsvTable table(
         dir / kSegmentCostsFile,
-        {"animator", "cost_unconstrained", "cost_constrained", "short_segments_unconstrained"});
+        {"animator", "cost_unconstrained", "cost_constrained", "short_segments_unconstrained"},
+        {"reference_frames"});
     data.segment_costs_source = table.source();
     for (const auto& row : table.rows()) {
       SegmentCostRow s;
@@ -216,6 +226,10 @@ StudyData ReadStudyData(const std::filesystem::path& dir, const StudyDataOptions
           ParseFinite(row.fields[2], table.Where(row.line, "cost_constrained"), "a finite cost");
       s.short_segments_unconstrained = ParseInt(
           row.fields[3], table.Where(row.line, "short_segments_unconstrained"), 0, "a count >= 0");
+      if (table.Has("reference_frames")) {
+        s.reference_frames = ParseInt(row.fields[4], table.Where(row.line, "reference_frames"), 1,
+                                      "a frame count >= 1");
+      }
       data.segment_costs.push_back(s);
     }
   }
@@ -376,11 +390,16 @@ std::string ComparisonsToCsv(const std::vector<ComparisonRow>& rows) {
 }
 
 std::string SegmentCostsToCsv(const std::vector<SegmentCostRow>& rows) {
-  std::string out = "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained\n";
+  // reference_frames (optional in the schema) only when every row knows it.
+  const bool frames = !rows.empty() && std::all_of(rows.begin(), rows.end(), [](const auto& s) {
+    return s.reference_frames > 0;
+  });
+  std::string out = "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained";
+  out += frames ? ",reference_frames\n" : "\n";
   for (const auto& s : rows) {
     out += s.animator + "," + FormatNumber(s.cost_unconstrained) + "," +
            FormatNumber(s.cost_constrained) + "," + std::to_string(s.short_segments_unconstrained) +
-           "\n";
+           (frames ? "," + std::to_string(s.reference_frames) : std::string()) + "\n";
   }
   return out;
 }

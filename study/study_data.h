@@ -7,6 +7,7 @@
 //                      one binary comparison per row: did the scorer prefer the animator's montage
 //                      (1) or the take shown (0)
 //   segment_costs.csv  animator,cost_unconstrained,cost_constrained,short_segments_unconstrained
+//                      [,reference_frames]
 //                      (optional) the montage cost without and with the Segment Length Constraint
 //
 // Readers check everything and throw InputError naming the file, line, column, value and
@@ -45,6 +46,9 @@ struct SegmentCostRow {
   double cost_unconstrained = 0.0;       // C_T of the optimum without the constraint (d = 0)
   double cost_constrained = 0.0;         // C_T with the Segment Length Constraint (d = 60)
   int short_segments_unconstrained = 0;  // segments of the unconstrained optimum not longer than d
+  // n, frames of the reference timeline the labelling ran on (optional column; 0 = not given).
+  // With it the analysis puts the increase on the paper's scale (study/study_analysis.h).
+  int reference_frames = 0;
   int line = 0;
 };
 

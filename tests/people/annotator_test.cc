@@ -138,3 +138,39 @@ TEST(AnnotatorTest, BadInput) {
 
 }  // namespace
 }  // namespace mmh::sim
+
+namespace mmh::sim {
+namespace {
+
+// The dead band h (intermittent control): the hand moves only when the opinion has left the
+// block by more than h, so the block dwells at a few positions (moving less than 0.001 slider
+// units a frame); h = 0 is the continuous pursuit.
+TEST(AnnotatorTest, MoveThresholdMakesTheBlockDwell) {
+  const std::vector<double> quality = TakeQuality(0.4, 5);
+  AnnotatorProfile p;  // with opinion noise and tremor
+  p.tremor = 0;        // so that a resting block is exactly still
+  const AnnotationSession continuous = AnnotateTake(quality, p, AnnotatorOptions{}, 3);
+  p.move_threshold = 2.0;
+  const AnnotationSession dwelling = AnnotateTake(quality, p, AnnotatorOptions{}, 3);
+  auto still_share = [](const std::vector<double>& x) {
+    int still = 0;
+    for (std::size_t i = 1; i < x.size(); ++i) still += std::abs(x[i] - x[i - 1]) < 1e-3;
+    return static_cast<double>(still) / (x.size() - 1);
+  };
+  EXPECT_LT(still_share(continuous.slider), 0.3) << still_share(continuous.slider);
+  EXPECT_GT(still_share(dwelling.slider), 0.6) << still_share(dwelling.slider);
+  // Same judgement (the threshold acts on the hand only), and the block still follows it.
+  EXPECT_EQ(continuous.judgement, dwelling.judgement);
+  double error = 0;
+  for (std::size_t i = 0; i < quality.size(); ++i) {
+    error += std::abs(dwelling.slider[i] - continuous.slider[i]);
+  }
+  EXPECT_LT(error / quality.size(), 2.0);
+  // Out of range: a clear error.
+  p.move_threshold = -1;
+  EXPECT_NE(ErrorOf([&] { p.Validate("annotator"); }).find("annotator.move_threshold"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace mmh::sim

@@ -145,7 +145,7 @@ TEST(ScorersTest, RankingsArePermutationsFollowingUtility) {
     a.takes = {AppealOf(0.2), AppealOf(0.5), AppealOf(0.8)};
     a.montage = AppealOf(0.95);
   }
-  const auto rows = RankOwnAnimations(appeals, sim::ViewerOptions{}, 1);
+  const auto rows = RankOwnAnimations(appeals, sim::ViewerOptions{}, {}, 1);
   ASSERT_EQ(rows.size(), 20u);
   StudyData data;
   data.rankings = rows;
@@ -156,6 +156,32 @@ TEST(ScorersTest, RankingsArePermutationsFollowingUtility) {
                                                   : 4;
     EXPECT_EQ(row.rank, expected) << row.animator << " " << row.item;
   }
+}
+
+// The self-appraisal biases reach the animators' rankings, not the scorers' comparisons.
+TEST(ScorersTest, SelfAppraisalBiasesTheAnimatorsOnly) {
+  std::vector<AnimationAppeals> appeals(20);
+  for (auto& a : appeals) {
+    // Take 1 best to any viewer, the montage worst (0.1 apart; viewing noise sd 0.05).
+    a.takes = {AppealOf(0.8), AppealOf(0.7), AppealOf(0.6)};
+    a.montage = AppealOf(0.5);
+  }
+  sim::SelfAppraisalOptions biased;
+  biased.progress_weight = 1.0;  // far larger than the differences: recording order decides
+  biased.choice_bonus = 0.5;
+  for (const auto& row : RankOwnAnimations(appeals, sim::ViewerOptions{}, biased, 1)) {
+    const double expected = row.item == "montage" ? 1
+                            : row.item == "take3" ? 2
+                            : row.item == "take2" ? 3
+                                                  : 4;
+    EXPECT_EQ(row.rank, expected) << row.animator << " " << row.item;
+  }
+  // Without the biases take 1 ranks first for most animators.
+  int take1_first = 0;
+  for (const auto& row : RankOwnAnimations(appeals, sim::ViewerOptions{}, {}, 1)) {
+    take1_first += row.item == "take1" && row.rank == 1;
+  }
+  EXPECT_GE(take1_first, 15);
 }
 
 }  // namespace

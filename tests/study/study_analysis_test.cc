@@ -197,3 +197,44 @@ TEST(AnalyzeStudy, OutputsAreDeterministicAndTidy) {
 
 }  // namespace
 }  // namespace mmh::study
+
+namespace mmh::study {
+namespace {
+
+// The constraint's increase on three scales, by hand (study_analysis.h): C0 = -300 and C = -294
+// over n = 200 reference frames: 2 % of |C0|, 100 * 6 / (-300 + 5 * 200) = 0.857 % on the paper's
+// scale (C_d = 5 - a'), 0.03 slider units per frame.
+TEST(AnalyzeStudy, SegmentConstraintOnThePapersScale) {
+  StudyData data = ReadStudyData(kExample);
+  data.segment_costs = {{.animator = "A01",
+                         .cost_unconstrained = -300,
+                         .cost_constrained = -294,
+                         .short_segments_unconstrained = 2,
+                         .reference_frames = 200},
+                        {.animator = "A02",
+                         .cost_unconstrained = -100,
+                         .cost_constrained = -100,
+                         .short_segments_unconstrained = 0,
+                         .reference_frames = 100}};
+  const StudyAnalysis a = AnalyzeStudy(data);
+  ASSERT_TRUE(a.segment_constraint);
+  const auto& s = *a.segment_constraint;
+  EXPECT_EQ(s.animators_with_short_segments, 1u);
+  EXPECT_NEAR(s.max_increase_percent, 2.0, 1e-12);
+  ASSERT_TRUE(s.max_paper_scale_percent && s.max_increase_per_frame);
+  EXPECT_NEAR(*s.max_paper_scale_percent, 600.0 / 700.0, 1e-12);
+  EXPECT_NEAR(*s.max_increase_per_frame, 0.03, 1e-12);
+  EXPECT_EQ(s.threshold_scale, "paper");
+  // Below 1 % on the paper's scale, although 2 % of |C0|.
+  EXPECT_TRUE(s.all_below_threshold);
+  EXPECT_NE(a.Report().find("on the paper's scale"), std::string::npos);
+  // Without the frame counts the decision falls back to |C0| and says so.
+  for (auto& row : data.segment_costs) row.reference_frames = 0;
+  const StudyAnalysis b = AnalyzeStudy(data);
+  EXPECT_FALSE(b.segment_constraint->max_paper_scale_percent);
+  EXPECT_EQ(b.segment_constraint->threshold_scale, "relative_to_abs_c0");
+  EXPECT_FALSE(b.segment_constraint->all_below_threshold);
+}
+
+}  // namespace
+}  // namespace mmh::study

@@ -210,3 +210,35 @@ TEST(StudyData, TakeNumberOfItem) {
 
 }  // namespace
 }  // namespace mmh::study
+
+namespace mmh::study {
+namespace {
+
+TEST(StudyData, ReferenceFramesColumnIsOptional) {
+  Files f;
+  f.segment_costs =
+      "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained,reference_frames\n"
+      "A,-200,-199,2,1500\n";
+  TempDir dir;
+  f.Write(dir);
+  const StudyData data = ReadStudyData(dir.path());
+  ASSERT_EQ(data.segment_costs.size(), 1u);
+  EXPECT_EQ(data.segment_costs[0].reference_frames, 1500);
+  // Written back only when every row has it.
+  EXPECT_NE(SegmentCostsToCsv(data.segment_costs).find(",reference_frames\nA,-200,-199,2,1500\n"),
+            std::string::npos);
+  StudyData without = data;
+  without.segment_costs[0].reference_frames = 0;
+  EXPECT_EQ(SegmentCostsToCsv(without.segment_costs).find("reference_frames"), std::string::npos);
+  f.segment_costs =
+      "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained,reference_frames\n"
+      "A,-200,-199,2,0\n";
+  ExpectContains(ErrorReading(f), {"segment_costs.csv:2", "column 'reference_frames'", "0"});
+  f.segment_costs =
+      "animator,cost_unconstrained,cost_constrained,short_segments_unconstrained,frames\n"
+      "A,-200,-199,2,10\n";
+  ExpectContains(ErrorReading(f), {"segment_costs.csv:1", "frames"});
+}
+
+}  // namespace
+}  // namespace mmh::study

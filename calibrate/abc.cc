@@ -1,0 +1,141 @@
+#include "calibrate/abc.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/error.h"
+
+namespace mmh::calibrate {
+
+void AbcOptions::Validate(const std::string& prefix) const {
+  if (!(accept_fraction > 0.0 && accept_fraction <= 1.0)) {
+    ThrowBadValue(prefix + ".accept_fraction", FormatNumber(accept_fraction), "a share in (0, 1]");
+  }
+}
+
+double Quantile(std::vector<double> values, double q) {
+  if (values.empty()) return NAN;
+  std::sort(values.begin(), values.end());
+  const double h = (values.size() - 1) * q;
+  const auto lo = static_cast<std::size_t>(std::floor(h));
+  const std::size_t hi = std::min(values.size() - 1, lo + 1);
+  return values[lo] + (h - lo) * (values[hi] - values[lo]);
+}
+
+AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
+                       const std::vector<std::pair<int, double>>& fit, const AbcOptions& options) {
+  options.Validate("calibration.abc");
+  AbcResult result;
+  const int n = static_cast<int>(simulations.size());
+  // Scales: the MAD of each fit statistic over the simulations that have it.
+  for (const auto& [k, observed] : fit) {
+    std::vector<double> values;
+    for (const Simulation& s : simulations) {
+      if (s.values[k]) values.push_back(*s.values[k]);
+    }
+    const double median = Quantile(values, 0.5);
+    for (double& v : values) v = std::abs(v - median);
+    double mad = 1.4826 * Quantile(values, 0.5);
+    // A statistic that barely varies (e.g. a count at its bound) gets its sd instead; a constant
+    // one cannot discriminate and weighs nothing.
+    if (!(mad > 0)) {
+      double mean = 0, sq = 0;
+      int m = 0;
+      for (const Simulation& s : simulations) {
+        if (s.values[k]) mean += *s.values[k], ++m;
+      }
+      mean = m ? mean / m : 0;
+      for (const Simulation& s : simulations) {
+        if (s.values[k]) sq += (*s.values[k] - mean) * (*s.values[k] - mean);
+      }
+      mad = m > 1 ? std::sqrt(sq / (m - 1)) : 0;
+    }
+    result.scales.push_back(mad);
+  }
+  result.distances.assign(n, NAN);
+  std::vector<int> usable;
+  for (int i = 0; i < n; ++i) {
+    double d2 = 0;
+    bool ok = true;
+    for (std::size_t f = 0; f < fit.size(); ++f) {
+      const auto& value = simulations[i].values[fit[f].first];
+      if (!value) {
+        ok = false;
+        break;
+      }
+      if (result.scales[f] > 0) {
+        const double z = (*value - fit[f].second) / result.scales[f];
+        d2 += z * z;
+      }
+    }
+    if (!ok) continue;
+    result.distances[i] = std::sqrt(d2);
+    usable.push_back(i);
+  }
+  if (usable.size() < 2) {
+    ThrowBadValue("calibration", std::to_string(usable.size()) + " simulations with every fit statistic",
+                  "at least 2 (run more sweep cells)");
+  }
+  // Nearest first; ties by index, so the result does not depend on anything but the inputs.
+  std::stable_sort(usable.begin(), usable.end(),
+                   [&](int a, int b) { return result.distances[a] < result.distances[b]; });
+  const int accept = std::max(
+      2, static_cast<int>(std::lround(options.accept_fraction * static_cast<double>(usable.size()))));
+  result.accepted.assign(usable.begin(), usable.begin() + std::min<int>(accept, usable.size()));
+  result.epsilon = result.distances[result.accepted.back()];
+  const int parameters = static_cast<int>(simulations.front().params.size());
+  for (int j = 0; j < parameters; ++j) {
+    std::vector<double> values;
+    for (int i : result.accepted) values.push_back(simulations[i].params[j]);
+    ParameterPosterior p;
+    p.median = Quantile(values, 0.5);
+    p.q05 = Quantile(values, 0.05);
+    p.q95 = Quantile(values, 0.95);
+    p.mean = std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+    double sq = 0;
+    for (double v : values) sq += (v - p.mean) * (v - p.mean);
+    p.sd = values.size() > 1 ? std::sqrt(sq / (values.size() - 1)) : 0;
+    result.posterior.push_back(p);
+  }
+  return result;
+}
+
+Sensitivity PriorSensitivity(const std::vector<Simulation>& simulations, int statistics) {
+  Sensitivity out;
+  const int parameters = simulations.empty() ? 0 : static_cast<int>(simulations.front().params.size());
+  out.coefficients.assign(statistics, std::vector<double>(parameters, NAN));
+  out.r_squared.assign(statistics, NAN);
+  out.samples.assign(statistics, 0);
+  for (int k = 0; k < statistics; ++k) {
+    std::vector<int> rows;
+    for (int i = 0; i < static_cast<int>(simulations.size()); ++i) {
+      if (simulations[i].values[k]) rows.push_back(i);
+    }
+    out.samples[k] = static_cast<int>(rows.size());
+    if (static_cast<int>(rows.size()) <= parameters + 1) continue;
+    const int m = static_cast<int>(rows.size());
+    Eigen::MatrixXd x(m, parameters + 1);
+    Eigen::VectorXd y(m);
+    for (int r = 0; r < m; ++r) {
+      x(r, 0) = 1.0;
+      for (int j = 0; j < parameters; ++j) x(r, j + 1) = simulations[rows[r]].params[j];
+      y(r) = *simulations[rows[r]].values[k];
+    }
+    const double y_mean = y.mean();
+    const double y_sd = std::sqrt((y.array() - y_mean).square().sum() / (m - 1));
+    if (!(y_sd > 0)) continue;
+    const Eigen::VectorXd beta = x.colPivHouseholderQr().solve(y);
+    const Eigen::VectorXd residual = y - x * beta;
+    out.r_squared[k] = 1.0 - residual.squaredNorm() / (y.array() - y_mean).square().sum();
+    for (int j = 0; j < parameters; ++j) {
+      const Eigen::VectorXd col = x.col(j + 1);
+      const double sd = std::sqrt((col.array() - col.mean()).square().sum() / (m - 1));
+      out.coefficients[k][j] = beta(j + 1) * sd / y_sd;
+    }
+  }
+  return out;
+}
+
+}  // namespace mmh::calibrate

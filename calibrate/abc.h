@@ -1,0 +1,70 @@
+// Approximate Bayesian computation by rejection (Pritchard et al. 1999; Beaumont, Zhang & Balding
+// 2002) on simulated studies: every simulation is one replicate study at a parameter vector θ
+// drawn from the prior (the sweep's Latin-hypercube sample over the parameters' ranges), with its
+// summary statistics s. With the paper's numbers t as the observed summaries,
+//
+//   d(θ) = sqrt( Σ_k ((s_k − t_k) / MAD_k)² )      over the fit targets k,
+//
+// MAD_k the median absolute deviation of s_k over all simulations (× 1.4826, so that it estimates
+// a standard deviation), and the simulations with the smallest `accept_fraction` of distances are
+// a sample of the approximate posterior p(θ | d ≤ ε).
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mmh::calibrate {
+
+struct Simulation {
+  std::vector<double> params;                 // θ, #parameters
+  std::vector<std::optional<double>> values;  // s, #statistics (nullopt: not computed)
+};
+
+// Options of RejectionAbc.
+struct AbcOptions {
+  double accept_fraction = 0.05;  // share of the simulations accepted, in (0, 1]
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("accept_fraction", accept_fraction);
+  }
+  void Validate(const std::string& prefix) const;
+};
+
+struct ParameterPosterior {
+  double median = 0.0;
+  double mean = 0.0;
+  double sd = 0.0;
+  double q05 = 0.0;  // 5 % and 95 % quantiles: the central 90 % credible interval
+  double q95 = 0.0;
+};
+
+struct AbcResult {
+  std::vector<double> scales;           // MAD_k of each fit statistic
+  std::vector<double> distances;        // d of every simulation (NaN: a fit statistic missing)
+  std::vector<int> accepted;            // indices of the accepted simulations, nearest first
+  double epsilon = 0.0;                 // the largest accepted distance
+  std::vector<ParameterPosterior> posterior;  // #parameters
+};
+
+// `fit` lists the statistics (indices into Simulation::values) and their observed values.
+// Simulations missing a fit statistic are never accepted. InputError when fewer than 2 usable
+// simulations remain or the options are invalid.
+AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
+                       const std::vector<std::pair<int, double>>& fit, const AbcOptions& options);
+
+// Which summaries identify which parameters: the standardised coefficients of the linear
+// regression of each statistic on all parameters over every simulation (prior predictive),
+// β_kj · sd(θ_j) / sd(s_k), and its R². A parameter no statistic moves is not identified.
+struct Sensitivity {
+  std::vector<std::vector<double>> coefficients;  // [statistic][parameter]
+  std::vector<double> r_squared;                  // [statistic]
+  std::vector<int> samples;                       // simulations with the statistic
+};
+Sensitivity PriorSensitivity(const std::vector<Simulation>& simulations, int statistics);
+
+// The q-quantile of `values` (type 7 of R's quantile(): linear between order statistics).
+double Quantile(std::vector<double> values, double q);
+
+}  // namespace mmh::calibrate

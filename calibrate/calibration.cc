@@ -1,0 +1,381 @@
+#include "calibrate/calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/config.h"
+#include "core/error.h"
+#include "core/rgbd_folder.h"
+#include "core/text_parsing.h"
+#include "study/simulated_study.h"
+#include "sweep/cell_store.h"
+#include "sweep/plan.h"
+
+namespace mmh::calibrate {
+namespace {
+
+std::string Num(double value) { return FormatNumber(value); }
+
+std::string Rounded(double value, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
+  return buffer;
+}
+
+int IndexOf(const std::vector<std::string>& names, const std::string& name) {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
+}
+
+// Reads a replicates.csv (study/simulated_study.h) into rows of values in `columns` order.
+std::vector<std::vector<std::optional<double>>> ReadReplicates(
+    const std::filesystem::path& file, const std::vector<std::string>& columns) {
+  const std::string text = ReadTextFile(file);
+  std::istringstream lines(text);
+  std::string line;
+  std::vector<int> column_of;  // file column -> index in columns (-1: not used)
+  std::vector<std::vector<std::optional<double>>> rows;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    const std::string_view content = Trim(line);
+    if (content.empty()) continue;
+    const std::vector<std::string_view> fields = SplitCsvFields(content);
+    if (column_of.empty()) {
+      for (const auto& f : fields) column_of.push_back(IndexOf(columns, std::string(f)));
+      for (const std::string& c : columns) {
+        if (std::find(fields.begin(), fields.end(), c) == fields.end()) {
+          ThrowBadValue(file.string() + ":1", "a header without the column '" + c + "'",
+                        "the columns of replicates.csv of this mmh version");
+        }
+      }
+      continue;
+    }
+    if (fields.size() != column_of.size()) {
+      ThrowBadValue(file.string() + ":" + std::to_string(number),
+                    std::to_string(fields.size()) + " fields",
+                    std::to_string(column_of.size()) + " as in the header");
+    }
+    std::vector<std::optional<double>> row(columns.size());
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      if (column_of[f] < 0 || fields[f].empty()) continue;
+      double value = 0;
+      if (!ParseDouble(fields[f], &value) || !std::isfinite(value)) {
+        ThrowBadValue(file.string() + ":" + std::to_string(number) + ", column '" +
+                          columns[column_of[f]] + "'",
+                      "'" + std::string(fields[f]) + "'", "a finite number or empty");
+      }
+      row[column_of[f]] = value;
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+TargetCheck Check(const Target& target, const std::vector<double>& values) {
+  TargetCheck c;
+  c.target = target;
+  c.samples = static_cast<int>(values.size());
+  if (values.empty()) return c;
+  c.median = Quantile(values, 0.5);
+  c.q05 = Quantile(values, 0.05);
+  c.q95 = Quantile(values, 0.95);
+  double below = 0;
+  for (double v : values) below += v < target.value ? 1.0 : (v == target.value ? 0.5 : 0.0);
+  c.quantile = below / values.size();
+  c.inside_central_90 = c.quantile >= 0.05 && c.quantile <= 0.95;
+  return c;
+}
+
+}  // namespace
+
+void CalibrationOptions::Validate(const std::string& prefix) const {
+  abc.Validate(prefix + ".abc");
+  if (ppc_replicates < 0 || ppc_replicates > 100'000) {
+    ThrowBadValue(prefix + ".ppc_replicates", std::to_string(ppc_replicates),
+                  "a number of studies in [0, 100000]");
+  }
+  if (digits < 1 || digits > 17) {
+    ThrowBadValue(prefix + ".digits", std::to_string(digits), "an integer in [1, 17]");
+  }
+}
+
+CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Targets& targets,
+                            const CalibrationOptions& options,
+                            const CalibrationProgress& progress) {
+  options.Validate("calibration");
+  const sweep::Plan plan = sweep::ReadPlan(sweep_dir);
+  const std::string where = (sweep_dir / "plan.json").string();
+  if (plan.spec.command != sweep::SweepCommand::kStudy) {
+    ThrowBadValue(where + ": command", std::string("\"") + sweep::CommandName(plan.spec.command) + "\"",
+                  "\"study\": a calibration sweep runs fast-fidelity studies");
+  }
+  if (plan.spec.samples.count == 0 || plan.spec.samples.axes.empty()) {
+    ThrowBadValue(where + ": samples", "none",
+                  "the parameters as sampled axes (random or latin_hypercube) over their prior "
+                  "ranges");
+  }
+  if (!plan.spec.grid.empty()) {
+    ThrowBadValue(where + ": grid", std::to_string(plan.spec.grid.size()) + " grid axes",
+                  "none: every parameter a sampled axis (a grid is not a prior)");
+  }
+  CalibrationResult result;
+  result.sweep_dir = sweep_dir;
+  for (const sweep::SampledAxis& axis : plan.spec.samples.axes) {
+    result.parameters.push_back({axis.key, axis.from, axis.to});
+  }
+  for (const auto& s : study::ReplicateStatistics(study::StudyAnalysis{})) {
+    result.statistics.push_back(s.name);
+  }
+  // Every replicate of every complete cell is a simulation at that cell's parameters.
+  for (const sweep::Cell& cell : plan.cells) {
+    const sweep::CellStatus status = sweep::ReadCellStatus(sweep_dir, cell.id);
+    const std::filesystem::path file = sweep::CellDir(sweep_dir, cell.id) / "out" / "replicates.csv";
+    if (status.state != sweep::CellState::kComplete || !std::filesystem::exists(file)) {
+      ++result.incomplete_cells;
+      continue;
+    }
+    ++result.cells;
+    std::vector<double> params;
+    for (const Parameter& p : result.parameters) {
+      const auto it = std::find_if(cell.params.begin(), cell.params.end(),
+                                   [&](const auto& kv) { return kv.first == p.key; });
+      if (it == cell.params.end() || !it->second.is_number()) {
+        ThrowBadValue(where + ": cell " + cell.id, "no number for " + p.key,
+                      "a value of every sampled axis");
+      }
+      params.push_back(it->second.get<double>());
+    }
+    for (auto& row : ReadReplicates(file, result.statistics)) {
+      result.simulations.push_back({params, std::move(row)});
+    }
+  }
+  if (result.cells == 0) {
+    ThrowBadValue(sweep_dir.string(), "a sweep without complete cells",
+                  "a finished sweep (mmh sweep status " + sweep_dir.string() + ")");
+  }
+  std::vector<std::pair<int, double>> fit;
+  for (const Target& t : targets.targets) {
+    if (t.role == TargetRole::kFit) fit.push_back({IndexOf(result.statistics, t.statistic), t.value});
+  }
+  result.abc = RejectionAbc(result.simulations, fit, options.abc);
+  result.sensitivity =
+      PriorSensitivity(result.simulations, static_cast<int>(result.statistics.size()));
+  for (const ParameterPosterior& p : result.abc.posterior) result.estimate.push_back(p.median);
+  for (const Target& t : targets.targets) {
+    const int k = IndexOf(result.statistics, t.statistic);
+    std::vector<double> values;
+    for (int i : result.abc.accepted) {
+      if (result.simulations[i].values[k]) values.push_back(*result.simulations[i].values[k]);
+    }
+    result.accepted_checks.push_back(Check(t, values));
+  }
+
+  // The calibrated config: the estimate, rounded, as config sections.
+  nlohmann::json calibrated = nlohmann::json::object();
+  Config config = Config::Load(sweep::CellConfigPath(sweep_dir, plan.cells.front()));
+  for (std::size_t j = 0; j < result.parameters.size(); ++j) {
+    const std::string value = Rounded(result.estimate[j], options.digits);
+    config.Set(result.parameters[j].key + "=" + value);
+    nlohmann::json* node = &calibrated;
+    const std::string& key = result.parameters[j].key;
+    std::size_t start = 0;
+    for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.', start)) {
+      node = &(*node)[key.substr(start, dot - start)];
+      start = dot + 1;
+    }
+    (*node)[key.substr(start)] = std::stod(value);
+  }
+  result.calibrated_config = calibrated;
+
+  // Posterior predictive check: new people and scorers at the estimate.
+  config.Set("population.seed=" + std::to_string(options.ppc_seed));
+  config.Set("study.seed=" + std::to_string(options.ppc_seed));
+  config.Set("run.metrics=false");
+  const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
+  result.ppc_config = study_config.ToJson();
+  for (int r = 0; r < options.ppc_replicates; ++r) {
+    const study::SimulatedStudy s = study::RunSimulatedStudy(study_config.ForReplicate(r), r);
+    std::vector<std::optional<double>> row;
+    for (const auto& statistic : study::ReplicateStatistics(s.analysis)) row.push_back(statistic.value);
+    result.ppc_values.push_back(std::move(row));
+    if (progress) progress(r + 1, options.ppc_replicates);
+  }
+  if (options.ppc_replicates > 0) {
+    for (const Target& t : targets.targets) {
+      const int k = IndexOf(result.statistics, t.statistic);
+      std::vector<double> values;
+      for (const auto& row : result.ppc_values) {
+        if (row[k]) values.push_back(*row[k]);
+      }
+      result.ppc.push_back(Check(t, values));
+    }
+    for (const Conclusion& c : targets.conclusions) {
+      const int k = IndexOf(result.statistics, c.statistic);
+      ConclusionCheck check;
+      check.conclusion = c;
+      for (const auto& row : result.ppc_values) {
+        if (!row[k]) continue;
+        ++check.replicates;
+        check.agree += ((*row[k] < c.bound) == c.below) ? 1 : 0;
+      }
+      check.rate = check.replicates ? static_cast<double>(check.agree) / check.replicates : 0.0;
+      result.conclusions.push_back(check);
+    }
+  }
+  return result;
+}
+
+void WriteCalibration(const std::filesystem::path& out, const CalibrationResult& result,
+                      const Targets& targets, const nlohmann::json& provenance) {
+  StagedFolder staged(out);
+  const std::filesystem::path& dir = staged.staging();
+  const std::size_t parameters = result.parameters.size();
+
+  // parameters.csv: the estimate and its uncertainty.
+  std::string csv = "parameter,prior_from,prior_to,estimate,posterior_mean,posterior_sd,q05,q95\n";
+  nlohmann::json params = nlohmann::json::array();
+  for (std::size_t j = 0; j < parameters; ++j) {
+    const Parameter& p = result.parameters[j];
+    const ParameterPosterior& post = result.abc.posterior[j];
+    csv += p.key + "," + Num(p.from) + "," + Num(p.to) + "," + Num(post.median) + "," +
+           Num(post.mean) + "," + Num(post.sd) + "," + Num(post.q05) + "," + Num(post.q95) + "\n";
+    params.push_back({{"key", p.key}, {"prior", {p.from, p.to}}, {"estimate", post.median},
+                      {"mean", post.mean}, {"sd", post.sd}, {"q05", post.q05}, {"q95", post.q95}});
+  }
+  WriteFileAtomically(dir / "parameters.csv", csv);
+
+  // posterior.csv: the accepted simulations (parameters, distance).
+  csv = "simulation,distance";
+  for (const Parameter& p : result.parameters) csv += "," + p.key;
+  csv += "\n";
+  for (int i : result.abc.accepted) {
+    csv += std::to_string(i) + "," + Num(result.abc.distances[i]);
+    for (double v : result.simulations[i].params) csv += "," + Num(v);
+    csv += "\n";
+  }
+  WriteFileAtomically(dir / "posterior.csv", csv);
+
+  // identification.csv: standardised sensitivity of every target statistic to every parameter.
+  csv = "statistic,role,samples,r_squared";
+  for (const Parameter& p : result.parameters) csv += "," + p.key;
+  csv += "\n";
+  nlohmann::json identification = nlohmann::json::array();
+  for (const Target& t : targets.targets) {
+    const int k = IndexOf(result.statistics, t.statistic);
+    csv += t.statistic + "," + RoleName(t.role) + "," +
+           std::to_string(result.sensitivity.samples[k]) + "," +
+           Num(result.sensitivity.r_squared[k]);
+    nlohmann::json row = {{"statistic", t.statistic}, {"r_squared", result.sensitivity.r_squared[k]}};
+    for (std::size_t j = 0; j < parameters; ++j) {
+      csv += "," + Num(result.sensitivity.coefficients[k][j]);
+      row["coefficients"][result.parameters[j].key] = result.sensitivity.coefficients[k][j];
+    }
+    csv += "\n";
+    identification.push_back(row);
+  }
+  WriteFileAtomically(dir / "identification.csv", csv);
+
+  // targets.csv: every reported number against the accepted and the predictive distributions.
+  csv = "statistic,role,paper,accepted_median,accepted_q05,accepted_q95,ppc_samples,ppc_median,"
+        "ppc_q05,ppc_q95,ppc_quantile,inside_central_90\n";
+  nlohmann::json checks = nlohmann::json::array();
+  for (std::size_t i = 0; i < targets.targets.size(); ++i) {
+    const Target& t = targets.targets[i];
+    const TargetCheck& a = result.accepted_checks[i];
+    csv += t.statistic + "," + RoleName(t.role) + "," + Num(t.value) + "," + Num(a.median) + "," +
+           Num(a.q05) + "," + Num(a.q95);
+    nlohmann::json j = {{"statistic", t.statistic}, {"role", RoleName(t.role)}, {"paper", t.value},
+                        {"accepted", {{"median", a.median}, {"q05", a.q05}, {"q95", a.q95}}}};
+    if (i < result.ppc.size()) {
+      const TargetCheck& p = result.ppc[i];
+      csv += "," + std::to_string(p.samples) + "," + Num(p.median) + "," + Num(p.q05) + "," +
+             Num(p.q95) + "," + Num(p.quantile) + "," + (p.inside_central_90 ? "1" : "0");
+      j["ppc"] = {{"samples", p.samples}, {"median", p.median},     {"q05", p.q05},
+                  {"q95", p.q95},         {"quantile", p.quantile}, {"inside_central_90", p.inside_central_90}};
+    } else {
+      csv += ",,,,,,";
+    }
+    csv += "\n";
+    checks.push_back(j);
+  }
+  WriteFileAtomically(dir / "targets.csv", csv);
+
+  csv = "conclusion,statistic,bound,below,role,replicates,agree,rate\n";
+  nlohmann::json conclusions = nlohmann::json::array();
+  for (const ConclusionCheck& c : result.conclusions) {
+    csv += c.conclusion.id + "," + c.conclusion.statistic + "," + Num(c.conclusion.bound) + "," +
+           (c.conclusion.below ? "1" : "0") + "," + RoleName(c.conclusion.role) + "," +
+           std::to_string(c.replicates) + "," + std::to_string(c.agree) + "," + Num(c.rate) + "\n";
+    conclusions.push_back({{"id", c.conclusion.id}, {"description", c.conclusion.description},
+                           {"role", RoleName(c.conclusion.role)}, {"replicates", c.replicates},
+                           {"agree", c.agree}, {"rate", c.rate}});
+  }
+  WriteFileAtomically(dir / "conclusions.csv", csv);
+
+  csv = "replicate";
+  for (const std::string& s : result.statistics) csv += "," + s;
+  csv += "\n";
+  for (std::size_t r = 0; r < result.ppc_values.size(); ++r) {
+    csv += std::to_string(r);
+    for (const auto& v : result.ppc_values[r]) csv += "," + (v ? Num(*v) : std::string());
+    csv += "\n";
+  }
+  WriteFileAtomically(dir / "ppc_replicates.csv", csv);
+  WriteFileAtomically(dir / "calibrated.json", result.calibrated_config.dump(2) + "\n");
+  WriteFileAtomically(dir / "config.resolved.json", result.ppc_config.dump(2) + "\n");
+
+  nlohmann::json j;
+  j["sweep"] = result.sweep_dir.string();
+  j["targets_file"] = targets.file.string();
+  j["cells"] = result.cells;
+  j["incomplete_cells"] = result.incomplete_cells;
+  j["simulations"] = result.simulations.size();
+  j["accepted"] = result.abc.accepted.size();
+  j["epsilon"] = result.abc.epsilon;
+  j["parameters"] = params;
+  j["targets"] = checks;
+  j["conclusions"] = conclusions;
+  j["identification"] = identification;
+  j["calibrated"] = result.calibrated_config;
+  WriteFileAtomically(dir / "calibration.json", j.dump(2) + "\n");
+
+  // report.md: the tables a reader needs first.
+  std::ostringstream md;
+  md << "# Calibration of the simulated people\n\n"
+     << result.simulations.size() << " simulated studies (" << result.cells << " cells of "
+     << result.sweep_dir.string() << "), " << result.abc.accepted.size()
+     << " accepted (distance <= " << Num(result.abc.epsilon) << ").\n\n"
+     << "| parameter | prior | estimate (posterior median) | central 90 % |\n|---|---|---|---|\n";
+  for (std::size_t j2 = 0; j2 < parameters; ++j2) {
+    const auto& p = result.parameters[j2];
+    const auto& post = result.abc.posterior[j2];
+    md << "| " << p.key << " | " << Num(p.from) << "–" << Num(p.to) << " | "
+       << Rounded(post.median, 3) << " | " << Rounded(post.q05, 3) << "–" << Rounded(post.q95, 3)
+       << " |\n";
+  }
+  md << "\n| statistic | role | paper | predictive median (90 %) | quantile of the paper's |\n"
+        "|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < result.ppc.size(); ++i) {
+    const auto& p = result.ppc[i];
+    md << "| " << p.target.statistic << " | " << RoleName(p.target.role) << " | "
+       << Num(p.target.value) << " | " << Rounded(p.median, 3) << " (" << Rounded(p.q05, 3) << "–"
+       << Rounded(p.q95, 3) << ") | " << Rounded(p.quantile, 3)
+       << (p.inside_central_90 ? "" : " (outside)") << " |\n";
+  }
+  if (!result.conclusions.empty()) {
+    md << "\n| conclusion | role | replicates agreeing with the paper |\n|---|---|---|\n";
+    for (const auto& c : result.conclusions) {
+      md << "| " << c.conclusion.id << " | " << RoleName(c.conclusion.role) << " | " << c.agree
+         << " / " << c.replicates << " = " << Rounded(c.rate, 3) << " |\n";
+    }
+  }
+  WriteFileAtomically(dir / "report.md", md.str());
+  WriteFileAtomically(dir / "run.json", provenance.dump(2) + "\n");
+  staged.Commit();
+}
+
+}  // namespace mmh::calibrate

@@ -1,0 +1,102 @@
+// Rejection ABC, its quantiles and the prior sensitivity against independent computations.
+#include "calibrate/abc.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "tests/test_util.h"
+
+namespace mmh::calibrate {
+namespace {
+
+using test_util::ErrorOf;
+
+TEST(AbcTest, QuantileIsRsType7) {
+  // R: quantile(c(1, 2, 3, 4, 10), c(0.05, 0.5, 0.95)) = 1.2, 3, 8.8
+  const std::vector<double> x = {10, 2, 4, 1, 3};
+  EXPECT_NEAR(Quantile(x, 0.05), 1.2, 1e-12);
+  EXPECT_NEAR(Quantile(x, 0.5), 3.0, 1e-12);
+  EXPECT_NEAR(Quantile(x, 0.95), 8.8, 1e-12);
+  EXPECT_TRUE(std::isnan(Quantile({}, 0.5)));
+}
+
+// A grid prior over θ in [0, 1]², summaries s = (θ1, θ1 + θ2), observed (0.3, 0.8): the accepted
+// simulations are exactly the nearest by the scaled distance, computed here independently by
+// brute force, and the posterior centres on θ = (0.3, 0.5).
+TEST(AbcTest, AcceptsTheNearestSimulationsAndCentresOnTheTruth) {
+  std::vector<Simulation> sims;
+  for (int i = 0; i <= 40; ++i) {
+    for (int j = 0; j <= 40; ++j) {
+      const double a = i / 40.0, b = j / 40.0;
+      sims.push_back({{a, b}, {a, a + b, std::nullopt}});
+    }
+  }
+  const std::vector<std::pair<int, double>> fit = {{0, 0.3}, {1, 0.8}};
+  AbcOptions options;
+  options.accept_fraction = 0.01;
+  const AbcResult r = RejectionAbc(sims, fit, options);
+  ASSERT_EQ(r.accepted.size(), 17u);  // round(0.01 * 1681)
+  // Brute force: MADs (× 1.4826) of a uniform grid's marginals, then the 17 nearest.
+  auto mad = [&](int k) {
+    std::vector<double> v;
+    for (const auto& s : sims) v.push_back(*s.values[k]);
+    std::sort(v.begin(), v.end());
+    const double median = v[v.size() / 2];
+    for (double& x : v) x = std::abs(x - median);
+    std::sort(v.begin(), v.end());
+    return 1.4826 * v[v.size() / 2];
+  };
+  const double m0 = mad(0), m1 = mad(1);
+  EXPECT_NEAR(r.scales[0], m0, 1e-12);
+  EXPECT_NEAR(r.scales[1], m1, 1e-12);
+  std::vector<int> order(sims.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto d = [&](int i) {
+    return std::hypot((*sims[i].values[0] - 0.3) / m0, (*sims[i].values[1] - 0.8) / m1);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return d(a) < d(b); });
+  for (std::size_t k = 0; k < r.accepted.size(); ++k) {
+    EXPECT_NEAR(r.distances[r.accepted[k]], d(order[k]), 1e-12);
+  }
+  EXPECT_NEAR(r.posterior[0].median, 0.3, 0.03);
+  EXPECT_NEAR(r.posterior[1].median, 0.5, 0.03);
+  EXPECT_LE(r.posterior[0].q05, 0.3);
+  EXPECT_GE(r.posterior[0].q95, 0.3);
+}
+
+TEST(AbcTest, SimulationsMissingAFitStatisticAreNeverAccepted) {
+  std::vector<Simulation> sims = {{{0.1}, {std::nullopt}}, {{0.2}, {0.5}}, {{0.3}, {0.6}}};
+  const AbcResult r = RejectionAbc(sims, {{0, 0.5}}, AbcOptions{.accept_fraction = 1.0});
+  EXPECT_EQ(r.accepted, (std::vector<int>{1, 2}));
+  EXPECT_TRUE(std::isnan(r.distances[0]));
+  sims.resize(2);
+  EXPECT_NE(ErrorOf([&] { RejectionAbc(sims, {{0, 0.5}}, {}); }).find("at least 2"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { AbcOptions{.accept_fraction = 0}.Validate("calibration.abc"); })
+                .find("calibration.abc.accept_fraction"),
+            std::string::npos);
+}
+
+// s0 = 2 θ0 exactly: standardised coefficient 1 on θ0, 0 on θ1, R² 1; s1 = θ1²: θ1 alone.
+TEST(AbcTest, PriorSensitivityFindsWhichParameterMovesWhichStatistic) {
+  std::vector<Simulation> sims;
+  for (int i = 0; i < 11; ++i) {
+    for (int j = 0; j < 11; ++j) {
+      const double a = i / 10.0, b = j / 10.0;
+      sims.push_back({{a, b}, {2 * a, b * b}});
+    }
+  }
+  const Sensitivity s = PriorSensitivity(sims, 2);
+  EXPECT_NEAR(s.coefficients[0][0], 1.0, 1e-9);
+  EXPECT_NEAR(s.coefficients[0][1], 0.0, 1e-9);
+  EXPECT_NEAR(s.r_squared[0], 1.0, 1e-9);
+  EXPECT_NEAR(s.coefficients[1][0], 0.0, 1e-9);
+  EXPECT_GT(s.coefficients[1][1], 0.9);
+  EXPECT_EQ(s.samples[0], 121);
+}
+
+}  // namespace
+}  // namespace mmh::calibrate
