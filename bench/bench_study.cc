@@ -36,20 +36,25 @@ void Report(benchmark::State& state, const mmh::study::SimulatedStudy& s) {
 }
 
 // One replicate of the paper's study (20 animators, 42 scorers) at fast fidelity; each iteration
-// is a new replicate (new people), as in `mmh study --replicates`.
+// is a new replicate (new people), as in `mmh study --replicates`. metrics:1 also computes every
+// animator's metrics.json (per-frame ADD/ADD-S, the truth montage), as replicate 0 of `mmh study`
+// does; metrics:0 is what the replicates beyond it and `mmh calibrate`'s sweeps cost.
 void BM_StudyFast(benchmark::State& state) {
   const auto config = Config(static_cast<int>(state.range(0)), "fast");
   int replicate = 0;
   for (auto _ : state) {
-    const auto s = mmh::study::RunSimulatedStudy(config.ForReplicate(replicate), replicate);
+    auto replicate_config = config.ForReplicate(replicate);
+    replicate_config.run.run.metrics = state.range(1) != 0;
+    const auto s = mmh::study::RunSimulatedStudy(replicate_config, replicate);
     ++replicate;
     benchmark::DoNotOptimize(s.analysis.h1.mean_m);
     Report(state, s);
   }
 }
 BENCHMARK(BM_StudyFast)
-    ->ArgName("animators")
-    ->Arg(20)
+    ->ArgNames({"animators", "metrics"})
+    ->Args({20, 0})
+    ->Args({20, 1})
     ->Unit(benchmark::kSecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime();

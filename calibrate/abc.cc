@@ -25,7 +25,8 @@ double Quantile(std::vector<double> values, double q) {
 }
 
 AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
-                       const std::vector<std::pair<int, double>>& fit, const AbcOptions& options) {
+                       const std::vector<std::pair<int, double>>& fit, const AbcOptions& options,
+                       const std::vector<double>& prior_from, const std::vector<double>& prior_to) {
   options.Validate("calibration.abc");
   AbcResult result;
   const int n = static_cast<int>(simulations.size());
@@ -86,9 +87,43 @@ AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
   result.accepted.assign(usable.begin(), usable.begin() + std::min<int>(accept, usable.size()));
   result.epsilon = result.distances[result.accepted.back()];
   const int parameters = static_cast<int>(simulations.front().params.size());
+  for (int i : result.accepted) result.accepted_params.push_back(simulations[i].params);
+  const int m = static_cast<int>(result.accepted.size());
+  const int f = static_cast<int>(fit.size());
+  if (options.regression_adjustment && result.epsilon > 0 && m > f + 1) {
+    // Weighted least squares of θ_j on the scaled summaries (s − t)/MAD among the accepted.
+    Eigen::MatrixXd x(m, f + 1);
+    Eigen::VectorXd w(m);
+    for (int r = 0; r < m; ++r) {
+      const int i = result.accepted[r];
+      const double u = result.distances[i] / result.epsilon;
+      w(r) = std::max(0.0, 1.0 - u * u);
+      x(r, 0) = 1.0;
+      for (int k = 0; k < f; ++k) {
+        const double scale = result.scales[k] > 0 ? result.scales[k] : 1.0;
+        x(r, k + 1) = (*simulations[i].values[fit[k].first] - fit[k].second) / scale;
+      }
+    }
+    const Eigen::VectorXd sw = w.array().sqrt();
+    const Eigen::MatrixXd xw = sw.asDiagonal() * x;
+    const auto qr = xw.colPivHouseholderQr();
+    for (int j = 0; j < parameters; ++j) {
+      Eigen::VectorXd y(m);
+      for (int r = 0; r < m; ++r) y(r) = simulations[result.accepted[r]].params[j];
+      const Eigen::VectorXd beta = qr.solve(sw.asDiagonal() * y);
+      for (int r = 0; r < m; ++r) {
+        double adjusted = y(r) - x.row(r).tail(f).dot(beta.tail(f));
+        if (j < static_cast<int>(prior_from.size())) {
+          adjusted = std::clamp(adjusted, std::min(prior_from[j], prior_to[j]),
+                                std::max(prior_from[j], prior_to[j]));
+        }
+        result.accepted_params[r][j] = adjusted;
+      }
+    }
+  }
   for (int j = 0; j < parameters; ++j) {
     std::vector<double> values;
-    for (int i : result.accepted) values.push_back(simulations[i].params[j]);
+    for (const auto& theta : result.accepted_params) values.push_back(theta[j]);
     ParameterPosterior p;
     p.median = Quantile(values, 0.5);
     p.q05 = Quantile(values, 0.05);

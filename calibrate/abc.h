@@ -7,7 +7,11 @@
 //
 // MAD_k the median absolute deviation of s_k over all simulations (× 1.4826, so that it estimates
 // a standard deviation), and the simulations with the smallest `accept_fraction` of distances are
-// a sample of the approximate posterior p(θ | d ≤ ε).
+// a sample of the approximate posterior p(θ | d ≤ ε). With `regression_adjustment` each accepted
+// θ_i is corrected for how far its summaries fell from the observed ones (Beaumont, Zhang &
+// Balding 2002, eq. 4): θ_i* = θ_i − β̂ᵀ (s_i − t), β̂ from the weighted least-squares regression
+// of θ on s among the accepted, Epanechnikov weights 1 − (d_i/ε)²; θ_i* is kept in the prior's
+// range. The adjustment removes the part of the posterior's spread that ε lets through.
 #pragma once
 
 #include <optional>
@@ -24,10 +28,12 @@ struct Simulation {
 // Options of RejectionAbc.
 struct AbcOptions {
   double accept_fraction = 0.05;  // share of the simulations accepted, in (0, 1]
+  bool regression_adjustment = true;
 
   template <class V>
   void VisitFields(V& v) {
     v("accept_fraction", accept_fraction);
+    v("regression_adjustment", regression_adjustment);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -45,14 +51,20 @@ struct AbcResult {
   std::vector<double> distances;        // d of every simulation (NaN: a fit statistic missing)
   std::vector<int> accepted;            // indices of the accepted simulations, nearest first
   double epsilon = 0.0;                 // the largest accepted distance
+  // θ of the accepted (after the regression adjustment, when on), [accepted][parameter].
+  std::vector<std::vector<double>> accepted_params;
   std::vector<ParameterPosterior> posterior;  // #parameters
 };
 
 // `fit` lists the statistics (indices into Simulation::values) and their observed values.
 // Simulations missing a fit statistic are never accepted. InputError when fewer than 2 usable
 // simulations remain or the options are invalid.
+// `prior_from` / `prior_to` bound each parameter (the adjusted values are clamped to them; empty:
+// unbounded).
 AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
-                       const std::vector<std::pair<int, double>>& fit, const AbcOptions& options);
+                       const std::vector<std::pair<int, double>>& fit, const AbcOptions& options,
+                       const std::vector<double>& prior_from = {},
+                       const std::vector<double>& prior_to = {});
 
 // Which summaries identify which parameters: the standardised coefficients of the linear
 // regression of each statistic on all parameters over every simulation (prior predictive),

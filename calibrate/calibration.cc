@@ -161,7 +161,9 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
   for (const Target& t : targets.targets) {
     if (t.role == TargetRole::kFit) fit.push_back({IndexOf(result.statistics, t.statistic), t.value});
   }
-  result.abc = RejectionAbc(result.simulations, fit, options.abc);
+  std::vector<double> from, to;
+  for (const Parameter& p : result.parameters) from.push_back(p.from), to.push_back(p.to);
+  result.abc = RejectionAbc(result.simulations, fit, options.abc, from, to);
   result.sensitivity =
       PriorSensitivity(result.simulations, static_cast<int>(result.statistics.size()));
   for (const ParameterPosterior& p : result.abc.posterior) result.estimate.push_back(p.median);
@@ -248,13 +250,16 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
   }
   WriteFileAtomically(dir / "parameters.csv", csv);
 
-  // posterior.csv: the accepted simulations (parameters, distance).
+  // posterior.csv: the accepted simulations (distance, parameters as sampled and as adjusted).
   csv = "simulation,distance";
   for (const Parameter& p : result.parameters) csv += "," + p.key;
+  for (const Parameter& p : result.parameters) csv += "," + p.key + ".adjusted";
   csv += "\n";
-  for (int i : result.abc.accepted) {
+  for (std::size_t r = 0; r < result.abc.accepted.size(); ++r) {
+    const int i = result.abc.accepted[r];
     csv += std::to_string(i) + "," + Num(result.abc.distances[i]);
     for (double v : result.simulations[i].params) csv += "," + Num(v);
+    for (double v : result.abc.accepted_params[r]) csv += "," + Num(v);
     csv += "\n";
   }
   WriteFileAtomically(dir / "posterior.csv", csv);

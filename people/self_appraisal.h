@@ -18,8 +18,8 @@
 //              "The IKEA effect", J. Consum. Psychol. 22(3)).
 //
 // π and c are in the viewer's utility units (latent quality 0..1). Scorers judge other people's
-// animations and have neither bias. With π = c = 0 the animators judge as scorers do (the model
-// before the calibration; configs/people/hand_set_2026_11.json).
+// animations and have neither bias. With π = c = 0 the animators judge as scorers do (the people
+// before the calibration: configs/people/hand_set_2026_11.json).
 #pragma once
 
 #include <string>
@@ -28,8 +28,9 @@ namespace mmh::sim {
 
 // Config section "self_appraisal".
 struct SelfAppraisalOptions {
-  double progress_weight = 0.0;  // π: utility the animator adds to their last take over the first
-  double choice_bonus = 0.0;     // c: utility the animator adds to their montage
+  // Calibrated to the paper's study (docs/calibration.md).
+  double progress_weight = 0.185;  // π: utility the animator adds to their last take over the first
+  double choice_bonus = 0.142;     // c: utility the animator adds to their montage
 
   template <class V>
   void VisitFields(V& v) {

@@ -37,6 +37,7 @@ TEST(AbcTest, AcceptsTheNearestSimulationsAndCentresOnTheTruth) {
   const std::vector<std::pair<int, double>> fit = {{0, 0.3}, {1, 0.8}};
   AbcOptions options;
   options.accept_fraction = 0.01;
+  options.regression_adjustment = false;
   const AbcResult r = RejectionAbc(sims, fit, options);
   ASSERT_EQ(r.accepted.size(), 17u);  // round(0.01 * 1681)
   // Brute force: MADs (× 1.4826) of a uniform grid's marginals, then the 17 nearest.
@@ -65,6 +66,16 @@ TEST(AbcTest, AcceptsTheNearestSimulationsAndCentresOnTheTruth) {
   EXPECT_NEAR(r.posterior[1].median, 0.5, 0.03);
   EXPECT_LE(r.posterior[0].q05, 0.3);
   EXPECT_GE(r.posterior[0].q95, 0.3);
+  // The summaries are linear in θ without noise: the regression adjustment (Beaumont et al. 2002)
+  // moves every accepted θ onto the truth exactly.
+  options.regression_adjustment = true;
+  const AbcResult adjusted = RejectionAbc(sims, fit, options, {0, 0}, {1, 1});
+  EXPECT_EQ(adjusted.accepted, r.accepted);
+  for (const auto& theta : adjusted.accepted_params) {
+    EXPECT_NEAR(theta[0], 0.3, 1e-9);
+    EXPECT_NEAR(theta[1], 0.5, 1e-9);
+  }
+  EXPECT_NEAR(adjusted.posterior[1].q95 - adjusted.posterior[1].q05, 0.0, 1e-9);
 }
 
 TEST(AbcTest, SimulationsMissingAFitStatisticAreNeverAccepted) {
