@@ -44,7 +44,8 @@ struct StructuredLightOptions {
   // The IR image, full scale 1: a dot of brightness 1 on a white Lambertian surface facing the
   // camera at 1 m peaks at projector_power (fall-off 1 / z^2), ambient IR light reflected by the
   // surface adds ambient * albedo; sensor noise sigma^2 = read_noise^2 + shot_gain * value;
-  // values clip at full scale and are quantised to adc_bits.
+  // values clip at full scale and are quantised to adc_bits (at most 12; window_px^2 (2^adc_bits -
+  // 1)^2 below 2^31: the matcher's sums are exact 32-bit integers).
   double projector_power = 0.6;
   double ambient = 0.02;
   double read_noise = 0.004;
