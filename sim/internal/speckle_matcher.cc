@@ -159,31 +159,30 @@ MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n,
   }
 }
 
-// Zero-mean normalised cross-correlation of windows of `count` pixels from their sums:
-// (count cross - sum_a sum_b) / sqrt((count sq_a - sum_a^2) (count sq_b - sum_b^2)), with the
-// inverse square roots given. The numerator is an integer below 2^53: exact in double.
-MMH_SIMD_CLONES void Zncc(const int32_t* __restrict cross, const int32_t* __restrict sum_a,
-                          const double* __restrict inverse_a, const int32_t* __restrict sum_b,
-                          const double* __restrict inverse_b, double count, int n,
-                          double* __restrict score) {
+// Zero-mean normalised cross-correlation of windows of `count` pixels from their sums at
+// disparity d: (count cross - sum_a sum_b) / sqrt((count sq_a - sum_a^2) (count sq_b - sum_b^2)),
+// with the inverse square roots given (the numerator is an integer below 2^53: exact in double);
+// then each pixel's best score over the disparities of its search [first, last] and the scores
+// beside it (for the parabola): called for each d in increasing order (ties keep the smaller d;
+// previous: the scores at d - 1).
+MMH_SIMD_CLONES void ScoreAndTakeBest(const int32_t* __restrict cross,
+                                      const int32_t* __restrict sum_a,
+                                      const double* __restrict inverse_a,
+                                      const int32_t* __restrict sum_b,
+                                      const double* __restrict inverse_b, double count, int d,
+                                      const int* __restrict first, const int* __restrict last,
+                                      int n, const double* __restrict previous,
+                                      double* __restrict score, double* __restrict best,
+                                      int* __restrict best_d, double* __restrict left,
+                                      double* __restrict right) {
   for (int k = 0; k < n; ++k) {
     const double numerator = count * static_cast<double>(cross[k]) -
                              static_cast<double>(sum_a[k]) * static_cast<double>(sum_b[k]);
-    score[k] = numerator * inverse_a[k] * inverse_b[k];
-  }
-}
-
-// The best score of every pixel over the disparities of its search [first, last], and the scores
-// beside it (for the parabola): called for each disparity d in increasing order (ties keep the
-// smaller d); previous: the scores at d - 1.
-MMH_SIMD_CLONES void TakeBest(const double* __restrict score, const double* __restrict previous,
-                              int d, const int* __restrict first, const int* __restrict last,
-                              int n, double* __restrict best, int* __restrict best_d,
-                              double* __restrict left, double* __restrict right) {
-  for (int k = 0; k < n; ++k) {
-    right[k] = d == best_d[k] + 1 ? score[k] : right[k];
-    const bool better = (d >= first[k]) & (d <= last[k]) & (score[k] > best[k]);
-    best[k] = better ? score[k] : best[k];
+    const double x = numerator * inverse_a[k] * inverse_b[k];
+    score[k] = x;
+    right[k] = d == best_d[k] + 1 ? x : right[k];
+    const bool better = (d >= first[k]) & (d <= last[k]) & (x > best[k]);
+    best[k] = better ? x : best[k];
     best_d[k] = better ? d : best_d[k];
     left[k] = better ? previous[k] : left[k];
   }
@@ -210,6 +209,27 @@ MMH_SIMD_CLONES void InverseNorms(const int32_t* __restrict sum, const int32_t* 
                          static_cast<double>(sum[k]) * static_cast<double>(sum[k]);
     const bool low = !(norm2 >= min_norm2) | (norm2 <= 0.0);
     inverse_norm[k] = low ? 0.0 : 1.0 / std::sqrt(norm2);
+  }
+}
+
+// The integer disparity at which each pixel's search is centred: the rendered disparity rounded,
+// at most `largest` (-1: nothing hit; in `low` a large number instead of -1).
+MMH_SIMD_CLONES void Centres(const float* __restrict disparity, int largest, size_t n,
+                             int* __restrict centre, int* __restrict low) {
+  for (size_t p = 0; p < n; ++p) {
+    const int rounded = static_cast<int>(std::floor(disparity[p] + 0.5f));
+    const int c = disparity[p] != 0.0f ? std::min(largest, rounded) : -1;
+    centre[p] = c;
+    low[p] = c < 0 ? std::numeric_limits<int>::max() / 2 : c;
+  }
+}
+
+// Why a pixel is not searched before its window is looked at: nothing hit, or IR shadow.
+MMH_SIMD_CLONES void Blocked(const int* __restrict centre, const uint8_t* __restrict occluded,
+                             size_t n, int* __restrict blocked) {
+  for (size_t p = 0; p < n; ++p) {
+    const int shadow = occluded[p] != 0 ? static_cast<int>(MissingCause::kShadow) : 0;
+    blocked[p] = centre[p] < 0 ? static_cast<int>(MissingCause::kNothing) : shadow;
   }
 }
 
@@ -265,6 +285,25 @@ MMH_SIMD_CLONES void Decide(const double* __restrict best, const int* __restrict
   }
 }
 
+// Depth units of matched pixels on the raw lattice (raw = round(raw_offset - 8 d), units from
+// the table, 0 outside [0, 2046] or the depth range: kRange); other pixels keep their code.
+MMH_SIMD_CLONES void LatticeDepth(const SpeckleOutput& output, const int32_t* __restrict table,
+                                  const int* __restrict code, const float* __restrict disparity,
+                                  int n, int32_t* __restrict units, int32_t* __restrict why) {
+  const float raw_offset = output.raw_offset, steps = output.subpixel_steps;
+  for (int k = 0; k < n; ++k) {
+    // Index 2047 (table entry 0): off the lattice (raw < 0 or > 2046) or not matched; written
+    // with min, max and bit masks, which GCC vectorises.
+    float raw = std::floor(raw_offset - steps * disparity[k] + 0.5f);
+    raw = std::max(-1.0f, std::min(raw, 2047.0f));
+    const int index = (static_cast<int>(raw) | (code[k] != 0 ? 2047 : 0)) & 2047;
+    units[k] = table[index];
+  }
+  for (int k = 0; k < n; ++k) {
+    why[k] = code[k] != 0 ? code[k] : units[k] != 0 ? 0 : static_cast<int>(MissingCause::kRange);
+  }
+}
+
 }  // namespace
 
 // Per task: a band's searches and window statistics (kBand rows), a segment's running column
@@ -286,6 +325,7 @@ struct SpeckleMatcher::BandScratch {
         second(kSegment),
         left(kSegment),
         right(kSegment),
+        none(kSegment, 0.0),
         best_d(kSegment) {}
   // Per row of the band (r width + u):
   std::vector<int> first, last;      // the search [first, last] (first > last: none)
@@ -301,6 +341,7 @@ struct SpeckleMatcher::BandScratch {
   std::vector<int> code;          // the verdict (MissingCause) per pixel
   std::vector<float> disparity;   // the matched disparity per pixel
   std::vector<double> best, second, left, right;
+  std::vector<double> none;  // the "scores at d - 1" of the first disparity (never used)
   std::vector<int> best_d;
 };
 
@@ -403,8 +444,9 @@ float SpeckleMatcher::Pattern(float x, int v) const {
 }
 
 int SpeckleMatcher::SearchCentre(float disparity) const {
-  if (disparity == 0.0f) return -1;
-  return std::min(max_d_ - options_.search_px - 2, static_cast<int>(std::lround(disparity)));
+  int centre, low;
+  Centres(&disparity, max_d_ - options_.search_px - 2, 1, &centre, &low);
+  return centre;
 }
 
 void SpeckleMatcher::RenderIr(const SpeckleScene& scene, uint32_t key, uint16_t* ir) const {
@@ -445,21 +487,16 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
   centre_.resize(pixels);
   centre_low_.resize(pixels);
   blocked_.resize(pixels);
-  for (size_t p = 0; p < pixels; ++p) {
-    const int c = SearchCentre(scene.disparity[p]);
-    centre_[p] = c;
-    centre_low_[p] = c < 0 ? std::numeric_limits<int>::max() / 2 : c;
-    blocked_[p] = static_cast<int>(c < 0                 ? MissingCause::kNothing
-                                   : scene.occluded[p] ? MissingCause::kShadow
-                                                       : MissingCause::kValid);
-  }
+  Centres(scene.disparity, max_d_ - options_.search_px - 2, pixels, centre_.data(),
+          centre_low_.data());
+  Blocked(centre_.data(), scene.occluded, pixels, blocked_.data());
   // Depth units of each raw value on the lattice (0: outside [min_depth, max_depth]).
-  units_by_raw_.resize(2047);
+  units_by_raw_.assign(2048, 0);  // 2048: raw 2047 means "off the lattice"
   for (int raw = 0; raw <= 2046; ++raw) {
     const float z = output.lattice / (output.raw_offset - static_cast<float>(raw));
     units_by_raw_[raw] =
         z >= output.min_depth && z <= output.max_depth
-            ? static_cast<uint16_t>(std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)))
+            ? static_cast<int32_t>(std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)))
             : 0;
   }
   // The IR image as padded 32-bit rows.
@@ -582,10 +619,10 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
         BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.cross.data());
         const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - d - x_min_);
         double* score = &s.scores[static_cast<size_t>(d - lo) * kSegment];
-        Zncc(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
-             &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, span, score);
-        TakeBest(score, d > row_lo ? score - kSegment : score, d, first, last, span,
-                 s.best.data(), s.best_d.data(), s.left.data(), s.right.data());
+        ScoreAndTakeBest(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
+                         &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, d,
+                         first, last, span, d > row_lo ? score - kSegment : s.none.data(), score,
+                         s.best.data(), s.best_d.data(), s.left.data(), s.right.data());
       }
       for (int d = row_lo; d <= row_hi; ++d) {
         TakeSecond(&s.scores[static_cast<size_t>(d - lo) * kSegment], d, first, last,
@@ -603,25 +640,22 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
 
 void SpeckleMatcher::Output(const SpeckleOutput& output, const int* code, const float* disparity,
                             int n, uint16_t* depth, MissingCause* cause) const {
-  for (int k = 0; k < n; ++k) {
-    auto why = static_cast<MissingCause>(code[k]);
-    uint16_t units = 0;
-    if (why == MissingCause::kValid) {
-      if (output.quantise) {
-        const float raw =
-            std::floor(output.raw_offset - output.subpixel_steps * disparity[k] + 0.5f);
-        units = raw >= 0.0f && raw <= 2046.0f ? units_by_raw_[static_cast<int>(raw)] : 0;
-      } else {
-        const float z = output.lattice / (output.subpixel_steps * disparity[k]);
-        if (z >= output.min_depth && z <= output.max_depth) {
-          units = static_cast<uint16_t>(
-              std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)));
-        }
-      }
-      if (units == 0) why = MissingCause::kRange;
+  int32_t units[kSegment], why[kSegment];
+  if (output.quantise) {
+    LatticeDepth(output, units_by_raw_.data(), code, disparity, n, units, why);
+  } else {
+    for (int k = 0; k < n; ++k) {
+      const float z = output.lattice / (output.subpixel_steps * disparity[k]);
+      const bool valid = code[k] == 0 && z >= output.min_depth && z <= output.max_depth;
+      units[k] = valid ? static_cast<int32_t>(
+                             std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)))
+                       : 0;
+      why[k] = code[k] != 0 ? code[k] : valid ? 0 : static_cast<int>(MissingCause::kRange);
     }
-    depth[k] = units;
-    if (cause != nullptr) cause[k] = why;
+  }
+  for (int k = 0; k < n; ++k) depth[k] = static_cast<uint16_t>(units[k]);
+  if (cause != nullptr) {
+    for (int k = 0; k < n; ++k) cause[k] = static_cast<MissingCause>(why[k]);
   }
 }
 

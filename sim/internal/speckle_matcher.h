@@ -84,7 +84,7 @@ class SpeckleMatcher {
   // Per frame and pixel: SearchCentre (-1: nothing hit), the same with a large number for -1,
   // and why the pixel is not searched (MissingCause: nothing hit, shadow; kValid: it is).
   std::vector<int> centre_, centre_low_, blocked_;
-  std::vector<uint16_t> units_by_raw_;  // per frame: depth units of raw values 0 .. 2046
+  std::vector<int32_t> units_by_raw_;  // per frame: depth units of raw values 0 .. 2047 (0: none)
   std::vector<int32_t> wide_ir_;        // per frame: the IR image, rows padded to width + 16
 };
 
