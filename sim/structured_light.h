@@ -68,6 +68,13 @@ struct StructuredLightOptions {
   double min_correlation = 0.5;
   double min_contrast = 0.005;
   double ambiguity_ratio = 0.95;
+  // Diagnostics (docs/tracker.md, "Structured-light frames"), both true on a real device:
+  // edge_candidates false searches only around the disparity at the window's centre (no edge
+  // fattening from the sides' surfaces); parabola_subpixel false reports the rendered disparity
+  // where the integer match lies within a pixel of it (no pixel locking, no sub-pixel noise; the
+  // integer match, its rejections and the matches to other surfaces stay).
+  bool edge_candidates = true;
+  bool parabola_subpixel = true;
 
   template <class V>
   void VisitFields(V& v) {
@@ -86,6 +93,8 @@ struct StructuredLightOptions {
     v("min_correlation", min_correlation);
     v("min_contrast", min_contrast);
     v("ambiguity_ratio", ambiguity_ratio);
+    v("edge_candidates", edge_candidates);
+    v("parabola_subpixel", parabola_subpixel);
   }
   void Validate(const std::string& prefix) const;
 };

@@ -248,12 +248,14 @@ MMH_SIMD_CLONES void Blocked(const int* __restrict blocked, const double* __rest
 MMH_SIMD_CLONES void SearchRanges(const int* __restrict low, const int* __restrict low_up,
                                   const int* __restrict low_down, const int* __restrict high,
                                   const int* __restrict high_up, const int* __restrict high_down,
-                                  const int* __restrict pre, int rad, int search, int max_d, int n,
-                                  int* __restrict first, int* __restrict last) {
+                                  const int* __restrict pre, int side, int search, int max_d,
+                                  int n, int* __restrict first, int* __restrict last) {
   for (int k = 0; k < n; ++k) {
-    const int a = std::min(std::min(std::min(low[k], low[k - rad]), std::min(low[k + rad], low_up[k])),
+    const int a = std::min(std::min(std::min(low[k], low[k - side]),
+                                    std::min(low[k + side], low_up[k])),
                            low_down[k]);
-    const int b = std::max(std::max(std::max(high[k], high[k - rad]), std::max(high[k + rad], high_up[k])),
+    const int b = std::max(std::max(std::max(high[k], high[k - side]),
+                                    std::max(high[k + side], high_up[k])),
                            high_down[k]);
     first[k] = pre[k] == 0 ? std::max(0, a - search) : std::numeric_limits<int>::max();
     last[k] = pre[k] == 0 ? std::min(max_d, b + search) : -1;
@@ -543,10 +545,12 @@ void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
   // Each pixel's search: within search_px of the rendered disparities at the window's centre
   // and the middles of its sides (a window across a depth edge scores both surfaces).
   Blocked(&blocked_[row + rad], &s.inverse_norm[at + rad], w - 2 * rad, &s.pre[at + rad]);
-  const size_t up = row - static_cast<size_t>(rad) * w, down = row + static_cast<size_t>(rad) * w;
+  // (Without edge_candidates the "sides" are the centre itself.)
+  const int side = options_.edge_candidates ? rad : 0;
+  const size_t up = row - static_cast<size_t>(side) * w, down = row + static_cast<size_t>(side) * w;
   SearchRanges(&centre_low_[row + rad], &centre_low_[up + rad], &centre_low_[down + rad],
                &centre_[row + rad], &centre_[up + rad], &centre_[down + rad], &s.pre[at + rad],
-               rad, options_.search_px, max_d_, w - 2 * rad, &s.first[at + rad],
+               side, options_.search_px, max_d_, w - 2 * rad, &s.first[at + rad],
                &s.last[at + rad]);
 }
 
@@ -631,6 +635,18 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
       Decide(s.best.data(), s.best_d.data(), s.second.data(), s.left.data(), s.right.data(),
              first, last, &s.pre[at + start], min_correlation, ambiguity, span, s.code.data(),
              s.disparity.data());
+      if (!options_.parabola_subpixel) {
+        // Where the integer match found the pixel's own surface (within a pixel of its
+        // rendered disparity), its rendered disparity; elsewhere (another surface: fattening)
+        // the parabola's.
+        const size_t p = static_cast<size_t>(v) * w + start;
+        for (int k = 0; k < span; ++k) {
+          const float rendered = scene.disparity[p + k];
+          if (std::abs(static_cast<float>(s.best_d[k]) - rendered) < 1.0f) {
+            s.disparity[k] = rendered;
+          }
+        }
+      }
       Output(output, s.code.data(), s.disparity.data(), span,
              depth + static_cast<size_t>(v) * w + start,
              cause != nullptr ? cause + static_cast<size_t>(v) * w + start : nullptr);
