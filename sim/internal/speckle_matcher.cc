@@ -276,8 +276,16 @@ MMH_SIMD_CLONES void Decide(const double* __restrict best, const int* __restrict
     const int d = best_d[k];
     const bool no_match = (peak < min_correlation) | (d == first[k]) | (d == last[k]);
     const bool ambiguous = second[k] > ambiguity * peak;
-    const double curvature = left[k] - 2.0 * peak + right[k];
-    double offset = curvature < 0.0 ? 0.5 * (left[k] - right[k]) / curvature : 0.0;
+    // Three-point Gaussian fit (the vertex of the parabola through the logarithms): the
+    // correlation peak of Gaussian speckle dots is Gaussian, and a parabola through the scores
+    // themselves pulls the disparity towards whole pixels (pixel locking, which real Kinect
+    // frames do not show: docs/sensor.md). A parabola where a score is not positive.
+    const bool positive = (left[k] > 0.0) & (peak > 0.0) & (right[k] > 0.0);
+    const double l = positive ? static_cast<double>(LnUnit(static_cast<float>(left[k]))) : left[k];
+    const double m = positive ? static_cast<double>(LnUnit(static_cast<float>(peak))) : peak;
+    const double r = positive ? static_cast<double>(LnUnit(static_cast<float>(right[k]))) : right[k];
+    const double curvature = l - 2.0 * m + r;
+    double offset = curvature < 0.0 ? 0.5 * (l - r) / curvature : 0.0;
     offset = offset > -0.5 ? offset : -0.5;
     offset = offset < 0.5 ? offset : 0.5;
     disparity[k] = static_cast<float>(d + offset);

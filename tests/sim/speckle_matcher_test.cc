@@ -137,8 +137,15 @@ struct Oracle {
       if (std::abs(d - best) >= 2) second = std::max(second, score[d - a]);
     }
     if (second > o.ambiguity_ratio * peak) return MissingCause::kAmbiguous;
-    const double left = score[best - 1 - a], right = score[best + 1 - a];
-    const double curvature = left - 2 * peak + right;
+    // The three-point Gaussian fit (a parabola through the logarithms; through the scores
+    // where one is not positive).
+    double left = score[best - 1 - a], middle = peak, right = score[best + 1 - a];
+    if (left > 0 && middle > 0 && right > 0) {
+      left = std::log(left);
+      middle = std::log(middle);
+      right = std::log(right);
+    }
+    const double curvature = left - 2 * middle + right;
     const double offset =
         std::clamp(curvature < 0 ? 0.5 * (left - right) / curvature : 0.0, -0.5, 0.5);
     const auto disparity = static_cast<float>(best + offset);
