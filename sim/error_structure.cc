@@ -8,20 +8,15 @@
 #include <string>
 
 #include "core/error.h"
+#include "sim/internal/depth_sample.h"
 
 namespace mmh::sim {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  const size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + middle, values.end());
-  return values[middle];
-}
-
-bool Valid(float z) { return std::isfinite(z) && z > 0; }
+using internal::Median;
+using internal::ValidDepth;
 
 }  // namespace
 
@@ -60,12 +55,12 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   for (int v = 0; v < height; ++v) {
     const float* row = &depth_m[static_cast<size_t>(v) * width];
     for (int u = 0; u < width;) {
-      if (Valid(row[u])) {
+      if (ValidDepth(row[u])) {
         ++u;
         continue;
       }
       const int first = u;
-      while (u < width && !Valid(row[u])) ++u;
+      while (u < width && !ValidDepth(row[u])) ++u;
       const double length = u - first;
       if (first == 0 || u == width) {
         s.missing_border += length;
@@ -105,7 +100,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   const Eigen::MatrixXd solve = (design.transpose() * design).inverse() * design.transpose();
   struct Patch {
     Eigen::VectorXd residual;
-    double sigma, model;
+    double sigma, model, incidence_deg;
   };
   std::vector<Patch> patches;
   for (int v0 = 0; v0 + n <= height; v0 += n) {
@@ -115,7 +110,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
       for (int j = 0; j < n && full; ++j) {
         for (int i = 0; i < n; ++i) {
           const float d = depth_m[static_cast<size_t>(v0 + j) * width + u0 + i];
-          if (!Valid(d) || d < options.min_depth_m || d > options.max_depth_m) {
+          if (!ValidDepth(d) || d < options.min_depth_m || d > options.max_depth_m) {
             full = false;
             break;
           }
@@ -136,6 +131,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
       const double step = LatticeStep(zc, calibration);
       const double sigma_z = noise.Sigma(zc, theta);
       p.model = std::sqrt(sigma_z * sigma_z + step * step / 12.0);
+      p.incidence_deg = theta * 180.0 / std::numbers::pi;
       patches.push_back(std::move(p));
     }
   }
@@ -143,11 +139,15 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   for (const Patch& p : patches) sigmas.push_back(p.sigma);
   const double typical = Median(sigmas);
   std::vector<double> numerator(lags + 1, 0.0), ratios;
+  std::array<std::vector<double>, ErrorStructure::kIncidenceBins> ratios_by_incidence;
   double energy = 0;
   for (const Patch& p : patches) {
     if (!(p.sigma <= options.outlier_factor * typical)) continue;
     ++s.patches;
     ratios.push_back(p.sigma / p.model);
+    const int bin = std::min(ErrorStructure::kIncidenceBins - 1,
+                             static_cast<int>(p.incidence_deg / ErrorStructure::kIncidenceBinDeg));
+    ratios_by_incidence[bin].push_back(p.sigma / p.model);
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
         const double r = p.residual[j * n + i];
@@ -160,6 +160,9 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
     }
   }
   s.noise_over_model = Median(ratios);
+  for (int b = 0; b < ErrorStructure::kIncidenceBins; ++b) {
+    s.noise_over_model_by_incidence[b] = Median(ratios_by_incidence[b]);
+  }
   s.autocorrelation.assign(lags, kNaN);
   if (energy > 0) {
     for (int k = 1; k <= lags; ++k) {
@@ -195,6 +198,7 @@ nlohmann::json ToJson(const ErrorStructure& s) {
           {"edge_band_px", s.edge_band_px},
           {"patches", s.patches},
           {"noise_over_model", s.noise_over_model},
+          {"noise_over_model_by_incidence_0_20_40_60_deg", s.noise_over_model_by_incidence},
           {"autocorrelation", s.autocorrelation},
           {"correlation_length_px", s.correlation_length_px}};
 }
@@ -221,6 +225,12 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
       {"shadow band width [px]", [](const ErrorStructure& s) { return s.shadow_band_px; }},
       {"edge band width [px]", [](const ErrorStructure& s) { return s.edge_band_px; }},
       {"small-patch noise / model", [](const ErrorStructure& s) { return s.noise_over_model; }},
+      {"  ... incidence 0-20 deg",
+       [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[0]; }},
+      {"  ... incidence 20-40 deg",
+       [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[1]; }},
+      {"  ... incidence 40-60 deg",
+       [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[2]; }},
       {"residual autocorrelation lag 1",
        [](const ErrorStructure& s) {
          return s.autocorrelation.empty() ? kNaN : s.autocorrelation[0];
@@ -289,7 +299,7 @@ RgbImage DepthSideBySide(const std::vector<const std::vector<float>*>& depths_m,
       for (int u = 0; u < width; ++u) {
         const float z = depth[static_cast<size_t>(v) * width + u];
         uint8_t* out = &image.rgb[3 * (static_cast<size_t>(v) * image.width + k * (width + kGap) + u)];
-        if (!Valid(z)) {
+        if (!ValidDepth(z)) {
           out[0] = 200;
           out[1] = out[2] = 0;
           continue;

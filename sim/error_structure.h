@@ -23,6 +23,7 @@
 // between lags, starting from rho(0) = 1).
 #pragma once
 
+#include <array>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -55,6 +56,11 @@ struct ErrorStructure {
   // Median over patches of residual sigma / sqrt(sigma_z^2 + step^2 / 12) (AxialNoiseModel,
   // LatticeStep): the small-patch noise relative to the per-pixel model.
   double noise_over_model = 0;
+  // The same per incidence angle of the patch's plane: [0, 20), [20, 40), [40, 60] deg (NaN: no
+  // patch); kIncidenceBins of kIncidenceBinDeg each.
+  static constexpr int kIncidenceBins = 3;
+  static constexpr double kIncidenceBinDeg = 20.0;
+  std::array<double, kIncidenceBins> noise_over_model_by_incidence{};
   std::vector<double> autocorrelation;  // rho(1) .. rho(patch_size / 2)
   double correlation_length_px = 0;
 };

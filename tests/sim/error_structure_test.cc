@@ -115,6 +115,10 @@ TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   // Small-patch noise against the per-pixel model at 1.5 m (sigma_z 3.5 mm, step 6.5 mm):
   // sqrt(3.5^2 + 6.5^2 / 12) = 4.0 mm, so 3 mm of noise is about 0.75 of it.
   EXPECT_NEAR(white.noise_over_model, 0.75, 0.08);
+  // The plane is turned about 8 deg from the camera: every patch falls in the first bin.
+  EXPECT_EQ(white.noise_over_model_by_incidence[0], white.noise_over_model);
+  EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[1]));
+  EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[2]));
 }
 
 TEST(ErrorStructure, BadInputNamesTheField) {
