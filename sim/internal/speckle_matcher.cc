@@ -2,6 +2,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
@@ -150,12 +151,30 @@ MMH_SIMD_CLONES void WidenRows(const uint16_t* __restrict ir, int width, int row
   }
 }
 
-// out[k] = sum_{i < window} in[k + i] (exact).
+// out[k] = sum_{i < window} in[k + i] (exact), by doubling: sums of 1, 2, 4, ... consecutive
+// values, those of window's binary digits added up (5 passes for 9 instead of 9); a and b:
+// scratch of n + window.
 MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n,
+                             int32_t* __restrict a, int32_t* __restrict b,
                              int32_t* __restrict out) {
-  for (int k = 0; k < n; ++k) out[k] = in[k];
-  for (int i = 1; i < window; ++i) {
-    for (int k = 0; k < n; ++k) out[k] += in[k + i];
+  const int total = n + window - 1;
+  const int32_t* sums = in;  // sums of `width` consecutive values, valid for k < total - width + 1
+  int32_t* next = a;
+  int offset = 0;
+  for (int width = 1;; width *= 2) {
+    if (window & width) {
+      if (offset == 0) {
+        for (int k = 0; k < n; ++k) out[k] = sums[k];
+      } else {
+        for (int k = 0; k < n; ++k) out[k] += sums[k + offset];
+      }
+      offset += width;
+    }
+    if (2 * width > window) break;
+    const int valid = total - 2 * width + 1;
+    for (int k = 0; k < valid; ++k) next[k] = sums[k] + sums[k + width];
+    sums = next;
+    next = next == a ? b : a;
   }
 }
 
@@ -328,6 +347,8 @@ struct SpeckleMatcher::BandScratch {
         column_sum(width),
         column_square(width),
         square(width),
+        box_a(width + kBlock + 32),
+        box_b(width + kBlock + 32),
         cross(kSegment),
         code(kSegment),
         disparity(kSegment),
@@ -344,6 +365,7 @@ struct SpeckleMatcher::BandScratch {
   std::vector<double> inverse_norm;  // 1 / sqrt(n sum of squares - sum^2); 0: low signal
   // Per row:
   std::vector<int32_t> column_sum, column_square, square;
+  std::vector<int32_t> box_a, box_b;  // BoxSums' scratch
   // Per segment:
   std::vector<int32_t> products;  // window column products, (d - lo) stride + k
   std::vector<int32_t> cross;
@@ -440,6 +462,8 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
   }
 }
 
+SpeckleMatcher::~SpeckleMatcher() = default;
+
 int SpeckleMatcher::Reference(int x, int v) const {
   return reference_[static_cast<size_t>(v) * columns_ + (x - x_min_)];
 }
@@ -523,8 +547,13 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
     }
   }
   const int bands = (height_ - 2 * rad + kBand - 1) / kBand;
+  // Every band overwrites what it reads of its scratch: which worker's scratch a band gets does
+  // not change its bytes.
+  scratch_.resize(std::max<size_t>(scratch_.size(), tbb::this_task_arena::max_concurrency()));
   tbb::parallel_for(tbb::blocked_range<int>(0, bands), [&](const tbb::blocked_range<int>& r) {
-    BandScratch scratch(width_);
+    std::unique_ptr<BandScratch>& slot = scratch_[tbb::this_task_arena::current_thread_index()];
+    if (!slot) slot = std::make_unique<BandScratch>(width_);
+    BandScratch& scratch = *slot;
     for (int b = r.begin(); b != r.end(); ++b) {
       const int v0 = rad + b * kBand;
       MatchBand(scene, output, v0, std::min(v0 + kBand, height_ - rad), scratch, depth, cause);
@@ -544,8 +573,10 @@ void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
   const int stride = w + kBlock;
   ColumnSums(&wide_ir_[static_cast<size_t>(v - rad) * stride], stride, window, w,
              s.column_sum.data(), s.column_square.data());
-  BoxSums(s.column_sum.data(), window, w - 2 * rad, &s.sum[at + rad]);
-  BoxSums(s.column_square.data(), window, w - 2 * rad, s.square.data() + rad);
+  BoxSums(s.column_sum.data(), window, w - 2 * rad, s.box_a.data(), s.box_b.data(),
+          &s.sum[at + rad]);
+  BoxSums(s.column_square.data(), window, w - 2 * rad, s.box_a.data(), s.box_b.data(),
+          s.square.data() + rad);
   const double min_norm2 = options_.min_contrast * options_.min_contrast * n * n *
                            static_cast<double>(levels_) * levels_;
   InverseNorms(&s.sum[at + rad], s.square.data() + rad, n, min_norm2, w - 2 * rad,
@@ -628,7 +659,8 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
       std::fill_n(s.best_d.begin(), span, -1);
       std::fill_n(s.second.begin(), span, -1.0);
       for (int d = row_lo; d <= row_hi; ++d) {
-        BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.cross.data());
+        BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.box_a.data(),
+                s.box_b.data(), s.cross.data());
         const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - d - x_min_);
         double* score = &s.scores[static_cast<size_t>(d - lo) * kSegment];
         ScoreAndTakeBest(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "sim/structured_light.h"
@@ -36,6 +37,7 @@ class SpeckleMatcher {
   // ones are matched as if at max_disparity and fail).
   SpeckleMatcher(const StructuredLightOptions& options, int width, int height,
                  double max_disparity);
+  ~SpeckleMatcher();
 
   // The IR image (#width by #height) in ADC counts (0 .. 2^adc_bits - 1), its sensor noise keyed
   // by `key` (counter-based: the same for any thread count).
@@ -86,6 +88,8 @@ class SpeckleMatcher {
   std::vector<int> centre_, centre_low_, blocked_;
   std::vector<int32_t> units_by_raw_;  // per frame: depth units of raw values 0 .. 2047 (0: none)
   std::vector<int32_t> wide_ir_;        // per frame: the IR image, rows padded to width + 16
+  // Scratch per worker thread (by its index in the task arena), kept from frame to frame.
+  std::vector<std::unique_ptr<BandScratch>> scratch_;
 };
 
 }  // namespace mmh::sim::internal
