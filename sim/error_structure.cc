@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <cstdio>
 #include <string>
 
 #include "core/error.h"
@@ -39,6 +40,82 @@ void ErrorStructureOptions::Validate(const std::string& prefix) const {
   }
 }
 
+std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width,
+                                          int height, const ErrorStructureOptions& options,
+                                          std::vector<double>* shadow_runs,
+                                          std::vector<double>* edge_runs) {
+  std::vector<MissingClass> classes(depth_m.size(), MissingClass::kValid);
+  for (int v = 0; v < height; ++v) {
+    const size_t row = static_cast<size_t>(v) * width;
+    for (int u = 0; u < width;) {
+      if (ValidDepth(depth_m[row + u])) {
+        ++u;
+        continue;
+      }
+      const int first = u;
+      while (u < width && !ValidDepth(depth_m[row + u])) ++u;
+      const double length = u - first;
+      MissingClass c;
+      if (first == 0 || u == width) {
+        c = MissingClass::kBorder;
+      } else {
+        const double left = depth_m[row + first - 1], right = depth_m[row + u];
+        const double nearer = std::min(left, right);
+        if (left - right > options.step_fraction * nearer) {
+          c = MissingClass::kShadow;
+          if (shadow_runs != nullptr) shadow_runs->push_back(length);
+        } else if (right - left > options.step_fraction * nearer) {
+          c = MissingClass::kEdge;
+          if (edge_runs != nullptr) edge_runs->push_back(length);
+        } else if (nearer > options.far_m) {
+          c = MissingClass::kRange;
+        } else {
+          c = MissingClass::kLowSignal;
+        }
+      }
+      std::fill(classes.begin() + row + first, classes.begin() + row + u, c);
+    }
+  }
+  return classes;
+}
+
+std::string FormatCauseTable(const std::vector<MissingClass>& classes,
+                             std::span<const MissingCause> causes) {
+  constexpr const char* kClassNames[] = {"valid", "border", "shadow", "edge", "range", "low signal"};
+  constexpr const char* kCauseNames[] = {"valid",    "border",   "nothing hit", "shadow",
+                                         "low signal", "no match", "ambiguous",  "range"};
+  constexpr int kClasses = 6, kCauses = 8;
+  if (classes.size() != causes.size()) {
+    ThrowBadValue("causes", std::to_string(causes.size()) + " pixels",
+                  std::to_string(classes.size()) + " pixels");
+  }
+  std::vector<double> count(kClasses * kCauses, 0.0);
+  for (size_t p = 0; p < classes.size(); ++p) {
+    count[static_cast<int>(classes[p]) * kCauses + static_cast<int>(causes[p])] += 1;
+  }
+  const double pixels = static_cast<double>(classes.size());
+  std::string text = "missing [% of pixels]: from the depth image (rows) against the sensor's own "
+                     "cause (columns)\n";
+  char cell[64];
+  std::snprintf(cell, sizeof(cell), "%-12s", "");
+  text += cell;
+  for (int c = 1; c < kCauses; ++c) {
+    std::snprintf(cell, sizeof(cell), "%12s", kCauseNames[c]);
+    text += cell;
+  }
+  text += "\n";
+  for (int k = 0; k < kClasses; ++k) {
+    std::snprintf(cell, sizeof(cell), "%-12s", kClassNames[k]);
+    text += cell;
+    for (int c = 1; c < kCauses; ++c) {
+      std::snprintf(cell, sizeof(cell), "%12.2f", 100 * count[k * kCauses + c] / pixels);
+      text += cell;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
 ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int width, int height,
                                      const PinholeIntrinsics& intrinsics,
                                      const KinectCalibration& calibration,
@@ -52,33 +129,16 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   ErrorStructure s;
   const double pixels = static_cast<double>(width) * height;
   std::vector<double> shadow_runs, edge_runs;
-  for (int v = 0; v < height; ++v) {
-    const float* row = &depth_m[static_cast<size_t>(v) * width];
-    for (int u = 0; u < width;) {
-      if (ValidDepth(row[u])) {
-        ++u;
-        continue;
-      }
-      const int first = u;
-      while (u < width && !ValidDepth(row[u])) ++u;
-      const double length = u - first;
-      if (first == 0 || u == width) {
-        s.missing_border += length;
-        continue;
-      }
-      const double left = row[first - 1], right = row[u];
-      const double nearer = std::min(left, right);
-      if (left - right > options.step_fraction * nearer) {
-        s.missing_shadow += length;
-        shadow_runs.push_back(length);
-      } else if (right - left > options.step_fraction * nearer) {
-        s.missing_edge += length;
-        edge_runs.push_back(length);
-      } else if (nearer > options.far_m) {
-        s.missing_range += length;
-      } else {
-        s.missing_low_signal += length;
-      }
+  const std::vector<MissingClass> classes =
+      ClassifyMissing(depth_m, width, height, options, &shadow_runs, &edge_runs);
+  for (const MissingClass c : classes) {
+    switch (c) {
+      case MissingClass::kValid: break;
+      case MissingClass::kBorder: s.missing_border += 1; break;
+      case MissingClass::kShadow: s.missing_shadow += 1; break;
+      case MissingClass::kEdge: s.missing_edge += 1; break;
+      case MissingClass::kRange: s.missing_range += 1; break;
+      case MissingClass::kLowSignal: s.missing_low_signal += 1; break;
     }
   }
   s.missing_border /= pixels;

@@ -24,6 +24,8 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
+#include <span>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -31,6 +33,7 @@
 #include "core/camera.h"
 #include "core/image_io.h"
 #include "sim/kinect_model.h"
+#include "sim/structured_light.h"
 
 namespace mmh::sim {
 
@@ -73,6 +76,21 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
                                      const ErrorStructureOptions& options = {});
 
 nlohmann::json ToJson(const ErrorStructure& structure);
+
+// Why a pixel is missing, judged from the depth image alone (real frames carry no labels): runs of
+// missing pixels along a row touching the image's side (border), with the far side on their left
+// (shadow: the projector sits to the right) or on their right (edge), between neighbours beyond
+// far_m (range), otherwise low signal. Run lengths of shadow and edge runs appended when given.
+enum class MissingClass : uint8_t { kValid = 0, kBorder, kShadow, kEdge, kRange, kLowSignal };
+std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width,
+                                          int height, const ErrorStructureOptions& options = {},
+                                          std::vector<double>* shadow_runs = nullptr,
+                                          std::vector<double>* edge_runs = nullptr);
+
+// The classes against a rendered frame's exact causes (KinectSensor::missing_causes), in % of all
+// pixels: how well the depth-image rules that classify real frames name the sensor's causes.
+std::string FormatCauseTable(const std::vector<MissingClass>& classes,
+                             std::span<const MissingCause> causes);
 
 // Real against rendered: one row per statistic, a column per named structure, then the ratio of
 // each rendered column (indices `rendered`) to the real one (index `reference`), and the goal

@@ -121,6 +121,28 @@ TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[2]));
 }
 
+TEST(ErrorStructure, CauseTableCountsEachClassAgainstEachCause) {
+  // One row, 10 pixels: a border run of 2 (the sensor says border), a shadow run of 3 beside a
+  // step down from 2 m to 1 m (the sensor: 2 shadow, 1 no match), valid pixels between.
+  const std::vector<float> depth = {0, 0, 2, 2, 0, 0, 0, 1, 1, 1};
+  const std::vector<MissingClass> classes = ClassifyMissing(depth, 10, 1);
+  ASSERT_EQ(classes[0], MissingClass::kBorder);
+  ASSERT_EQ(classes[4], MissingClass::kShadow);
+  const std::vector<MissingCause> causes = {
+      MissingCause::kBorder, MissingCause::kBorder, MissingCause::kValid,  MissingCause::kValid,
+      MissingCause::kShadow, MissingCause::kShadow, MissingCause::kNoMatch, MissingCause::kValid,
+      MissingCause::kValid,  MissingCause::kValid};
+  const std::string table = FormatCauseTable(classes, causes);
+  // Rows: class; columns: border, nothing hit, shadow, low signal, no match, ambiguous, range.
+  EXPECT_NE(table.find("border             20.00        0.00        0.00        0.00        0.00"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("shadow              0.00        0.00       20.00        0.00       10.00"),
+            std::string::npos)
+      << table;
+  EXPECT_THROW(FormatCauseTable(classes, std::vector<MissingCause>(3)), InputError);
+}
+
 TEST(ErrorStructure, BadInputNamesTheField) {
   ErrorStructureOptions options;
   options.patch_size = 8;
