@@ -3,9 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
-#include <cstdio>
 #include <string>
 
 #include "core/error.h"
@@ -40,8 +40,8 @@ void ErrorStructureOptions::Validate(const std::string& prefix) const {
   }
 }
 
-std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width,
-                                          int height, const ErrorStructureOptions& options,
+std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width, int height,
+                                          const ErrorStructureOptions& options,
                                           std::vector<double>* shadow_runs,
                                           std::vector<double>* edge_runs) {
   std::vector<MissingClass> classes(depth_m.size(), MissingClass::kValid);
@@ -81,9 +81,10 @@ std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int
 
 std::string FormatCauseTable(const std::vector<MissingClass>& classes,
                              std::span<const MissingCause> causes) {
-  constexpr const char* kClassNames[] = {"valid", "border", "shadow", "edge", "range", "low signal"};
-  constexpr const char* kCauseNames[] = {"valid",    "border",   "nothing hit", "shadow",
-                                         "low signal", "no match", "ambiguous",  "range"};
+  constexpr const char* kClassNames[] = {"valid", "border", "shadow",
+                                         "edge",  "range",  "low signal"};
+  constexpr const char* kCauseNames[] = {"valid",      "border",   "nothing hit", "shadow",
+                                         "low signal", "no match", "ambiguous",   "range"};
   constexpr int kClasses = 6, kCauses = 8;
   if (classes.size() != causes.size()) {
     ThrowBadValue("causes", std::to_string(causes.size()) + " pixels",
@@ -94,8 +95,9 @@ std::string FormatCauseTable(const std::vector<MissingClass>& classes,
     count[static_cast<int>(classes[p]) * kCauses + static_cast<int>(causes[p])] += 1;
   }
   const double pixels = static_cast<double>(classes.size());
-  std::string text = "missing [% of pixels]: from the depth image (rows) against the sensor's own "
-                     "cause (columns)\n";
+  std::string text =
+      "missing [% of pixels]: from the depth image (rows) against the sensor's own "
+      "cause (columns)\n";
   char cell[64];
   std::snprintf(cell, sizeof(cell), "%-12s", "");
   text += cell;
@@ -133,12 +135,23 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
       ClassifyMissing(depth_m, width, height, options, &shadow_runs, &edge_runs);
   for (const MissingClass c : classes) {
     switch (c) {
-      case MissingClass::kValid: break;
-      case MissingClass::kBorder: s.missing_border += 1; break;
-      case MissingClass::kShadow: s.missing_shadow += 1; break;
-      case MissingClass::kEdge: s.missing_edge += 1; break;
-      case MissingClass::kRange: s.missing_range += 1; break;
-      case MissingClass::kLowSignal: s.missing_low_signal += 1; break;
+      case MissingClass::kValid:
+        break;
+      case MissingClass::kBorder:
+        s.missing_border += 1;
+        break;
+      case MissingClass::kShadow:
+        s.missing_shadow += 1;
+        break;
+      case MissingClass::kEdge:
+        s.missing_edge += 1;
+        break;
+      case MissingClass::kRange:
+        s.missing_range += 1;
+        break;
+      case MissingClass::kLowSignal:
+        s.missing_low_signal += 1;
+        break;
     }
   }
   s.missing_border /= pixels;
@@ -326,7 +339,8 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
   for (const auto& row : rows) {
     for (size_t c = 0; c < row.size(); ++c) widths[c] = std::max(widths[c], row[c].size());
   }
-  for (size_t c = 0; c < header.size(); ++c) widths[c + 1] = std::max(widths[c + 1], header[c].size());
+  for (size_t c = 0; c < header.size(); ++c)
+    widths[c + 1] = std::max(widths[c + 1], header[c].size());
   auto line = [&](const std::vector<std::string>& cells) {
     std::string text = cells[0] + std::string(widths[0] - cells[0].size(), ' ');
     for (size_t c = 1; c < cells.size(); ++c) {
@@ -358,7 +372,8 @@ RgbImage DepthSideBySide(const std::vector<const std::vector<float>*>& depths_m,
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         const float z = depth[static_cast<size_t>(v) * width + u];
-        uint8_t* out = &image.rgb[3 * (static_cast<size_t>(v) * image.width + k * (width + kGap) + u)];
+        uint8_t* out =
+            &image.rgb[3 * (static_cast<size_t>(v) * image.width + k * (width + kGap) + u)];
         if (!ValidDepth(z)) {
           out[0] = 200;
           out[1] = out[2] = 0;

@@ -25,8 +25,8 @@
 
 #include <array>
 #include <cstdint>
-#include <span>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,7 +43,7 @@ struct ErrorStructureOptions {
   int patch_size = 9;           // odd
   double max_incidence_deg = 60.0;
   double outlier_factor = 3.0;
-  double min_depth_m = 0.4;     // patches outside [min_depth_m, max_depth_m] are left out
+  double min_depth_m = 0.4;  // patches outside [min_depth_m, max_depth_m] are left out
   double max_depth_m = 4.0;
 
   void Validate(const std::string& prefix) const;
@@ -82,8 +82,8 @@ nlohmann::json ToJson(const ErrorStructure& structure);
 // (shadow: the projector sits to the right) or on their right (edge), between neighbours beyond
 // far_m (range), otherwise low signal. Run lengths of shadow and edge runs appended when given.
 enum class MissingClass : uint8_t { kValid = 0, kBorder, kShadow, kEdge, kRange, kLowSignal };
-std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width,
-                                          int height, const ErrorStructureOptions& options = {},
+std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width, int height,
+                                          const ErrorStructureOptions& options = {},
                                           std::vector<double>* shadow_runs = nullptr,
                                           std::vector<double>* edge_runs = nullptr);
 

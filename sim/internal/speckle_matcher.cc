@@ -26,7 +26,7 @@ constexpr int kBand = 8;
 // The IR image's constants as floats for the vector loop.
 struct IrParams {
   float power = 0, ambient = 0, read2 = 0, shot = 0, levels = 0, gain = 0;
-  float x_min = 0;         // the pattern's first column
+  float x_min = 0;          // the pattern's first column
   float last_position = 0;  // the last pattern sample with a right neighbour
 };
 
@@ -68,8 +68,8 @@ MMH_SIMD_CLONES void IrRow(const IrParams& p, const float* __restrict pattern,
     const float t = position - static_cast<float>(k);
     // The pattern reaches the point from the projector unless something is in between (the IR
     // shadow). (Selections as products with 0 or 1 so that the loops vectorise.)
-    dots[u] = (pattern[k] + t * (pattern[k + 1] - pattern[k])) *
-              static_cast<float>(occluded[u] == 0);
+    dots[u] =
+        (pattern[k] + t * (pattern[k + 1] - pattern[k])) * static_cast<float>(occluded[u] == 0);
   }
   const float power = p.power, ambient = p.ambient, read2 = p.read2, shot = p.shot,
               levels = p.levels, gain = p.gain;
@@ -131,9 +131,8 @@ MMH_SIMD_CLONES void ColumnProducts(const int32_t* __restrict a, size_t a_stride
 // Moves column products one row down: sums[k] += a_in[k] b_in[k] - a_out[k] b_out[k] (exact), n a
 // multiple of kBlock.
 MMH_SIMD_CLONES void SlideProducts(const int32_t* __restrict a_in, const int32_t* __restrict b_in,
-                                   const int32_t* __restrict a_out,
-                                   const int32_t* __restrict b_out, int n,
-                                   int32_t* __restrict sums) {
+                                   const int32_t* __restrict a_out, const int32_t* __restrict b_out,
+                                   int n, int32_t* __restrict sums) {
   for (int base = 0; base < n; base += kBlock) {
     for (int k = base; k < base + kBlock; ++k) {
       sums[k] += a_in[k] * b_in[k] - a_out[k] * b_out[k];
@@ -154,9 +153,8 @@ MMH_SIMD_CLONES void WidenRows(const uint16_t* __restrict ir, int width, int row
 // out[k] = sum_{i < window} in[k + i] (exact), by doubling: sums of 1, 2, 4, ... consecutive
 // values, those of window's binary digits added up (5 passes for 9 instead of 9); a and b:
 // scratch of n + window.
-MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n,
-                             int32_t* __restrict a, int32_t* __restrict b,
-                             int32_t* __restrict out) {
+MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n, int32_t* __restrict a,
+                             int32_t* __restrict b, int32_t* __restrict out) {
   const int total = n + window - 1;
   const int32_t* sums = in;  // sums of `width` consecutive values, valid for k < total - width + 1
   int32_t* next = a;
@@ -184,16 +182,13 @@ MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n,
 // then each pixel's best score over the disparities of its search [first, last] and the scores
 // beside it (for the parabola): called for each d in increasing order (ties keep the smaller d;
 // previous: the scores at d - 1).
-MMH_SIMD_CLONES void ScoreAndTakeBest(const int32_t* __restrict cross,
-                                      const int32_t* __restrict sum_a,
-                                      const double* __restrict inverse_a,
-                                      const int32_t* __restrict sum_b,
-                                      const double* __restrict inverse_b, double count, int d,
-                                      const int* __restrict first, const int* __restrict last,
-                                      int n, const double* __restrict previous,
-                                      double* __restrict score, double* __restrict best,
-                                      int* __restrict best_d, double* __restrict left,
-                                      double* __restrict right) {
+MMH_SIMD_CLONES void ScoreAndTakeBest(
+    const int32_t* __restrict cross, const int32_t* __restrict sum_a,
+    const double* __restrict inverse_a, const int32_t* __restrict sum_b,
+    const double* __restrict inverse_b, double count, int d, const int* __restrict first,
+    const int* __restrict last, int n, const double* __restrict previous, double* __restrict score,
+    double* __restrict best, int* __restrict best_d, double* __restrict left,
+    double* __restrict right) {
   for (int k = 0; k < n; ++k) {
     const double numerator = count * static_cast<double>(cross[k]) -
                              static_cast<double>(sum_a[k]) * static_cast<double>(sum_b[k]);
@@ -208,9 +203,9 @@ MMH_SIMD_CLONES void ScoreAndTakeBest(const int32_t* __restrict cross,
 }
 
 // The best score at least two pixels from the peak (the ambiguity test).
-MMH_SIMD_CLONES void TakeSecond(const double* __restrict score, int d,
-                                const int* __restrict first, const int* __restrict last,
-                                const int* __restrict best_d, int n, double* __restrict second) {
+MMH_SIMD_CLONES void TakeSecond(const double* __restrict score, int d, const int* __restrict first,
+                                const int* __restrict last, const int* __restrict best_d, int n,
+                                double* __restrict second) {
   for (int k = 0; k < n; ++k) {
     const int distance = d - best_d[k];
     const bool take = (d >= first[k]) & (d <= last[k]) & ((distance >= 2) | (distance <= -2)) &
@@ -244,8 +239,9 @@ MMH_SIMD_CLONES void Centres(const float* __restrict disparity, int largest, siz
 }
 
 // Why a pixel is not searched before its window is looked at: nothing hit, or IR shadow.
-MMH_SIMD_CLONES void Blocked(const int* __restrict centre, const uint8_t* __restrict occluded,
-                             size_t n, int* __restrict blocked) {
+MMH_SIMD_CLONES void GeometryBlocked(const int* __restrict centre,
+                                     const uint8_t* __restrict occluded, size_t n,
+                                     int* __restrict blocked) {
   for (size_t p = 0; p < n; ++p) {
     const int shadow = occluded[p] != 0 ? static_cast<int>(MissingCause::kShadow) : 0;
     blocked[p] = centre[p] < 0 ? static_cast<int>(MissingCause::kNothing) : shadow;
@@ -253,8 +249,9 @@ MMH_SIMD_CLONES void Blocked(const int* __restrict centre, const uint8_t* __rest
 }
 
 // Why a pixel is not searched (0: it is): nothing hit, IR shadow, low signal.
-MMH_SIMD_CLONES void Blocked(const int* __restrict blocked, const double* __restrict inverse_norm,
-                             int n, int* __restrict pre) {
+MMH_SIMD_CLONES void WindowBlocked(const int* __restrict blocked,
+                                   const double* __restrict inverse_norm, int n,
+                                   int* __restrict pre) {
   for (int k = 0; k < n; ++k) {
     const int low = inverse_norm[k] == 0.0 ? static_cast<int>(MissingCause::kLowSignal) : 0;
     pre[k] = blocked[k] != 0 ? blocked[k] : low;
@@ -267,15 +264,14 @@ MMH_SIMD_CLONES void Blocked(const int* __restrict blocked, const double* __rest
 MMH_SIMD_CLONES void SearchRanges(const int* __restrict low, const int* __restrict low_up,
                                   const int* __restrict low_down, const int* __restrict high,
                                   const int* __restrict high_up, const int* __restrict high_down,
-                                  const int* __restrict pre, int side, int search, int max_d,
-                                  int n, int* __restrict first, int* __restrict last) {
+                                  const int* __restrict pre, int side, int search, int max_d, int n,
+                                  int* __restrict first, int* __restrict last) {
   for (int k = 0; k < n; ++k) {
-    const int a = std::min(std::min(std::min(low[k], low[k - side]),
-                                    std::min(low[k + side], low_up[k])),
-                           low_down[k]);
-    const int b = std::max(std::max(std::max(high[k], high[k - side]),
-                                    std::max(high[k + side], high_up[k])),
-                           high_down[k]);
+    const int a = std::min(
+        std::min(std::min(low[k], low[k - side]), std::min(low[k + side], low_up[k])), low_down[k]);
+    const int b =
+        std::max(std::max(std::max(high[k], high[k - side]), std::max(high[k + side], high_up[k])),
+                 high_down[k]);
     first[k] = pre[k] == 0 ? std::max(0, a - search) : std::numeric_limits<int>::max();
     last[k] = pre[k] == 0 ? std::min(max_d, b + search) : -1;
   }
@@ -302,7 +298,8 @@ MMH_SIMD_CLONES void Decide(const double* __restrict best, const int* __restrict
     const bool positive = (left[k] > 0.0) & (peak > 0.0) & (right[k] > 0.0);
     const double l = positive ? static_cast<double>(LnUnit(static_cast<float>(left[k]))) : left[k];
     const double m = positive ? static_cast<double>(LnUnit(static_cast<float>(peak))) : peak;
-    const double r = positive ? static_cast<double>(LnUnit(static_cast<float>(right[k]))) : right[k];
+    const double r =
+        positive ? static_cast<double>(LnUnit(static_cast<float>(right[k]))) : right[k];
     const double curvature = l - 2.0 * m + r;
     double offset = curvature < 0.0 ? 0.5 * (l - r) / curvature : 0.0;
     offset = offset > -0.5 ? offset : -0.5;
@@ -369,9 +366,9 @@ struct SpeckleMatcher::BandScratch {
   // Per segment:
   std::vector<int32_t> products;  // window column products, (d - lo) stride + k
   std::vector<int32_t> cross;
-  std::vector<double> scores;     // (d - lo) kSegment + k
-  std::vector<int> code;          // the verdict (MissingCause) per pixel
-  std::vector<float> disparity;   // the matched disparity per pixel
+  std::vector<double> scores;    // (d - lo) kSegment + k
+  std::vector<int> code;         // the verdict (MissingCause) per pixel
+  std::vector<float> disparity;  // the matched disparity per pixel
   std::vector<double> best, second, left, right;
   std::vector<double> none;  // the "scores at d - 1" of the first disparity (never used)
   std::vector<int> best_d;
@@ -398,7 +395,8 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
   const double reach = 3.0 * sigma;
   const double x0 = x_min_ - reach, x1 = x_max + reach;
   const double y0 = -reach, y1 = height + reach;
-  const auto dots = static_cast<uint64_t>(std::llround(options.dot_density * (x1 - x0) * (y1 - y0)));
+  const auto dots =
+      static_cast<uint64_t>(std::llround(options.dot_density * (x1 - x0) * (y1 - y0)));
   const double inverse_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
   for (uint64_t i = 0; i < dots; ++i) {
     const uint64_t key = Mix64(options.pattern_seed ^ Mix64(3 * i + 0x9E3779B97F4A7C15ULL));
@@ -407,7 +405,8 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
     const double brightness = 0.5 + 0.5 * Uniform(Mix64(key + 2));
     const int row_first = std::max(0, static_cast<int>(std::ceil(y - reach)));
     const int row_last = std::min(height - 1, static_cast<int>(std::floor(y + reach)));
-    const int k_first = std::max(0, static_cast<int>(std::ceil((x - reach - x_min_) * kSubsamples)));
+    const int k_first =
+        std::max(0, static_cast<int>(std::ceil((x - reach - x_min_) * kSubsamples)));
     const int k_last =
         std::min(samples_ - 1, static_cast<int>(std::floor((x + reach - x_min_) * kSubsamples)));
     for (int r = row_first; r <= row_last; ++r) {
@@ -429,7 +428,8 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
   for (int v = 0; v < height; ++v) {
     for (int c = 0; c < columns_; ++c) {
       reference_[static_cast<size_t>(v) * columns_ + c] = static_cast<int32_t>(std::lround(
-          scale * pattern_[static_cast<size_t>(v) * samples_ + static_cast<size_t>(c) * kSubsamples]));
+          scale *
+          pattern_[static_cast<size_t>(v) * samples_ + static_cast<size_t>(c) * kSubsamples]));
     }
   }
   // Its window statistics (exact integer sums).
@@ -523,7 +523,7 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
   blocked_.resize(pixels);
   Centres(scene.disparity, max_d_ - options_.search_px - 2, pixels, centre_.data(),
           centre_low_.data());
-  Blocked(centre_.data(), scene.occluded, pixels, blocked_.data());
+  GeometryBlocked(centre_.data(), scene.occluded, pixels, blocked_.data());
   // Depth units of each raw value on the lattice (0: outside [min_depth, max_depth]).
   units_by_raw_.assign(2048, 0);  // 2048: raw 2047 means "off the lattice"
   for (int raw = 0; raw <= 2046; ++raw) {
@@ -583,7 +583,7 @@ void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
                &s.inverse_norm[at + rad]);
   // Each pixel's search: within search_px of the rendered disparities at the window's centre
   // and the middles of its sides (a window across a depth edge scores both surfaces).
-  Blocked(&blocked_[row + rad], &s.inverse_norm[at + rad], w - 2 * rad, &s.pre[at + rad]);
+  WindowBlocked(&blocked_[row + rad], &s.inverse_norm[at + rad], w - 2 * rad, &s.pre[at + rad]);
   // (Without edge_candidates the "sides" are the centre itself.)
   const int side = options_.edge_candidates ? rad : 0;
   const size_t up = row - static_cast<size_t>(side) * w, down = row + static_cast<size_t>(side) * w;
@@ -594,8 +594,7 @@ void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
 }
 
 void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& output, int v0,
-                               int v1, BandScratch& s, uint16_t* depth,
-                               MissingCause* cause) const {
+                               int v1, BandScratch& s, uint16_t* depth, MissingCause* cause) const {
   const int w = width_;
   const int rad = radius_;
   const int window = options_.window_px;
@@ -664,16 +663,16 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
         const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - d - x_min_);
         double* score = &s.scores[static_cast<size_t>(d - lo) * kSegment];
         ScoreAndTakeBest(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
-                         &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, d,
-                         first, last, span, d > row_lo ? score - kSegment : s.none.data(), score,
+                         &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, d, first,
+                         last, span, d > row_lo ? score - kSegment : s.none.data(), score,
                          s.best.data(), s.best_d.data(), s.left.data(), s.right.data());
       }
       for (int d = row_lo; d <= row_hi; ++d) {
         TakeSecond(&s.scores[static_cast<size_t>(d - lo) * kSegment], d, first, last,
                    s.best_d.data(), span, s.second.data());
       }
-      Decide(s.best.data(), s.best_d.data(), s.second.data(), s.left.data(), s.right.data(),
-             first, last, &s.pre[at + start], min_correlation, ambiguity, span, s.code.data(),
+      Decide(s.best.data(), s.best_d.data(), s.second.data(), s.left.data(), s.right.data(), first,
+             last, &s.pre[at + start], min_correlation, ambiguity, span, s.code.data(),
              s.disparity.data());
       if (!options_.parabola_subpixel) {
         // Where the integer match found the pixel's own surface (within a pixel of its

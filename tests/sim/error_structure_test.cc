@@ -6,7 +6,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -129,7 +128,7 @@ TEST(ErrorStructure, CauseTableCountsEachClassAgainstEachCause) {
   ASSERT_EQ(classes[0], MissingClass::kBorder);
   ASSERT_EQ(classes[4], MissingClass::kShadow);
   const std::vector<MissingCause> causes = {
-      MissingCause::kBorder, MissingCause::kBorder, MissingCause::kValid,  MissingCause::kValid,
+      MissingCause::kBorder, MissingCause::kBorder, MissingCause::kValid,   MissingCause::kValid,
       MissingCause::kShadow, MissingCause::kShadow, MissingCause::kNoMatch, MissingCause::kValid,
       MissingCause::kValid,  MissingCause::kValid};
   const std::string table = FormatCauseTable(classes, causes);

@@ -26,8 +26,8 @@ struct TestScene {
   std::vector<float> depth, disparity, cos_incidence, diffuse, specular;
   std::vector<uint8_t> occluded;
   SpeckleScene view() const {
-    return {depth.data(),   disparity.data(), cos_incidence.data(), occluded.data(),
-            diffuse.data(), specular.data()};
+    return {depth.data(),    disparity.data(), cos_incidence.data(),
+            occluded.data(), diffuse.data(),   specular.data()};
   }
 };
 
@@ -43,11 +43,11 @@ TestScene MakeScene() {
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 0; u < kWidth; ++u) {
       const size_t p = static_cast<size_t>(v) * kWidth + u;
-      if (u == 150) continue;  // nothing hit
-      double z = u < 90 ? 0.9 : 1.6 + 0.004 * v + 0.001 * u;  // a step, then a slanted floor
-      if (u >= 100 && u < 104) s.occluded[p] = 1;              // IR shadow beside the step
+      if (u == 150) continue;                                   // nothing hit
+      double z = u < 90 ? 0.9 : 1.6 + 0.004 * v + 0.001 * u;    // a step, then a slanted floor
+      if (u >= 100 && u < 104) s.occluded[p] = 1;               // IR shadow beside the step
       if (u >= 170 && v >= 30 && v < 50) s.diffuse[p] = 0.02f;  // dark
-      if (u >= 20 && u < 40 && v >= 20 && v < 40) {              // glossy, facing the camera
+      if (u >= 20 && u < 40 && v >= 20 && v < 40) {             // glossy, facing the camera
         s.specular[p] = 0.3f;
         s.cos_incidence[p] = 1.0f;
       }
@@ -84,7 +84,9 @@ struct Oracle {
     const int n = o.window_px * o.window_px;
     if (u < rad || v < rad || u >= kWidth - rad || v >= kHeight - rad) return MissingCause::kBorder;
     const size_t p = static_cast<size_t>(v) * kWidth + u;
-    auto centre = [&](int x, int y) { return matcher.SearchCentre(scene.disparity[y * kWidth + x]); };
+    auto centre = [&](int x, int y) {
+      return matcher.SearchCentre(scene.disparity[y * kWidth + x]);
+    };
     if (centre(u, v) < 0) return MissingCause::kNothing;
     if (scene.occluded[p]) return MissingCause::kShadow;
     const double levels = (1 << o.adc_bits) - 1;
@@ -129,7 +131,8 @@ struct Oracle {
       }
       score.push_back(var_b > 0 ? cross / std::sqrt(var_a * var_b) : 0.0);
     }
-    const int best = a + static_cast<int>(std::max_element(score.begin(), score.end()) - score.begin());
+    const int best =
+        a + static_cast<int>(std::max_element(score.begin(), score.end()) - score.begin());
     const double peak = score[best - a];
     if (peak < o.min_correlation || best == a || best == b) return MissingCause::kNoMatch;
     double second = -1;

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "core/error.h"
-#include "tests/sim/test_meshes.h"
 #include "sim/kinect_sensor.h"
+#include "tests/sim/test_meshes.h"
 
 namespace mmh::sim {
 namespace {
@@ -23,9 +23,9 @@ using test_meshes::Quad;
 
 // A wall facing the camera (camera at the origin looking along +z) at depth z.
 Rigid3 WallAt(double z) {
-  return Rigid3(Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(),
-                                                   -Eigen::Vector3d::UnitZ()),
-                Eigen::Vector3d(0, 0, z));
+  return Rigid3(
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ()),
+      Eigen::Vector3d(0, 0, z));
 }
 
 KinectSensorOptions StructuredLight() {
@@ -102,7 +102,8 @@ TEST(StructuredLight, DarkFarAndMirrorSurfacesLoseThePattern) {
   EXPECT_GT(CentreStats(RenderWall(3.5, SurfaceMaterial{0.02, 0.0}, options), 3.5).missing,
             0.9 * 400 * 300);
   // The same grey wall returns less and less with distance.
-  const double near = CentreStats(RenderWall(1.5, SurfaceMaterial{0.15, 0.0}, options), 1.5).missing;
+  const double near =
+      CentreStats(RenderWall(1.5, SurfaceMaterial{0.15, 0.0}, options), 1.5).missing;
   const double far = CentreStats(RenderWall(3.8, SurfaceMaterial{0.15, 0.0}, options), 3.8).missing;
   EXPECT_LT(near, 0.05 * 400 * 300);
   EXPECT_GT(far, near + 0.2 * 400 * 300);
@@ -196,7 +197,8 @@ TEST(StructuredLight, ShadowOfANearBoxFallsOnTheProjectorSideAndIsMissing) {
   // beyond the edge.
   const int right_edge = static_cast<int>(std::floor(k.cx + k.fx * 0.1 / 1.0));
   int valid_right = 0;
-  for (int u = right_edge + 8; u < right_edge + 20; ++u) valid_right += frame.depth[v * k.width + u] != 0;
+  for (int u = right_edge + 8; u < right_edge + 20; ++u)
+    valid_right += frame.depth[v * k.width + u] != 0;
   EXPECT_GE(valid_right, 10);
 }
 
