@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -133,32 +134,13 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   std::vector<double> shadow_runs, edge_runs;
   const std::vector<MissingClass> classes =
       ClassifyMissing(depth_m, width, height, options, &shadow_runs, &edge_runs);
-  for (const MissingClass c : classes) {
-    switch (c) {
-      case MissingClass::kValid:
-        break;
-      case MissingClass::kBorder:
-        s.missing_border += 1;
-        break;
-      case MissingClass::kShadow:
-        s.missing_shadow += 1;
-        break;
-      case MissingClass::kEdge:
-        s.missing_edge += 1;
-        break;
-      case MissingClass::kRange:
-        s.missing_range += 1;
-        break;
-      case MissingClass::kLowSignal:
-        s.missing_low_signal += 1;
-        break;
-    }
-  }
-  s.missing_border /= pixels;
-  s.missing_shadow /= pixels;
-  s.missing_edge /= pixels;
-  s.missing_range /= pixels;
-  s.missing_low_signal /= pixels;
+  std::array<double, 6> count{};  // per MissingClass
+  for (const MissingClass c : classes) count[static_cast<int>(c)] += 1;
+  s.missing_border = count[static_cast<int>(MissingClass::kBorder)] / pixels;
+  s.missing_shadow = count[static_cast<int>(MissingClass::kShadow)] / pixels;
+  s.missing_edge = count[static_cast<int>(MissingClass::kEdge)] / pixels;
+  s.missing_range = count[static_cast<int>(MissingClass::kRange)] / pixels;
+  s.missing_low_signal = count[static_cast<int>(MissingClass::kLowSignal)] / pixels;
   s.shadow_band_px = Median(shadow_runs);
   s.edge_band_px = Median(edge_runs);
 
