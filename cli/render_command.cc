@@ -101,6 +101,7 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   // Both sensor modes over the same scene: the statistical model and structured light.
   std::vector<sim::SensorStatistics> rendered;
   std::vector<float> first_frames[2];
+  std::string cause_table;  // structured light, first frame
   for (const sim::SensorMode mode : {sim::SensorMode::kStatistical,
                                      sim::SensorMode::kStructuredLight}) {
     sim::KinectSensorOptions sensor_options = render.sensor;
@@ -108,6 +109,7 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
     const bool structured = mode == sim::SensorMode::kStructuredLight;
     const std::string name = structured ? "rendered SL" : "rendered stat.";
     sim::KinectSensor sensor(sensor_options, &table_top.scene(), table_top.table_T_camera());
+    sensor.KeepMissingCauses(structured);
     sim::ErrorStructure mean;
     for (int i = 0; i < args.frames; ++i) {
       const double t = i / render.sensor.frame_rate;
@@ -130,12 +132,17 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
                                                         frame.depth_intrinsics,
                                                         render.sensor.calibration,
                                                         render.sensor.axial));
+        if (structured) {
+          cause_table = sim::FormatCauseTable(sim::ClassifyMissing(depth_m, width, height),
+                                              sensor.missing_causes());
+        }
       }
     }
     columns.push_back(rendered[rendered.size() - args.frames]);
   }
   std::cout << sim::FormatSensorTable(columns) << "\n"
-            << sim::FormatRealismTable(structure_names, structures, 0, {2, 3});
+            << sim::FormatRealismTable(structure_names, structures, 0, {2, 3}) << "\n"
+            << "structured light, first frame: " << cause_table;
   if (!args.common.out_dir.empty()) {
     const std::filesystem::path out = args.common.out_dir;
     EnsureDirectory(out);

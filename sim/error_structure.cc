@@ -2,26 +2,23 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <string>
 
 #include "core/error.h"
+#include "sim/internal/depth_sample.h"
 
 namespace mmh::sim {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double Median(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  const size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + middle, values.end());
-  return values[middle];
-}
-
-bool Valid(float z) { return std::isfinite(z) && z > 0; }
+using internal::Median;
+using internal::ValidDepth;
 
 }  // namespace
 
@@ -44,6 +41,84 @@ void ErrorStructureOptions::Validate(const std::string& prefix) const {
   }
 }
 
+std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width, int height,
+                                          const ErrorStructureOptions& options,
+                                          std::vector<double>* shadow_runs,
+                                          std::vector<double>* edge_runs) {
+  std::vector<MissingClass> classes(depth_m.size(), MissingClass::kValid);
+  for (int v = 0; v < height; ++v) {
+    const size_t row = static_cast<size_t>(v) * width;
+    for (int u = 0; u < width;) {
+      if (ValidDepth(depth_m[row + u])) {
+        ++u;
+        continue;
+      }
+      const int first = u;
+      while (u < width && !ValidDepth(depth_m[row + u])) ++u;
+      const double length = u - first;
+      MissingClass c;
+      if (first == 0 || u == width) {
+        c = MissingClass::kBorder;
+      } else {
+        const double left = depth_m[row + first - 1], right = depth_m[row + u];
+        const double nearer = std::min(left, right);
+        if (left - right > options.step_fraction * nearer) {
+          c = MissingClass::kShadow;
+          if (shadow_runs != nullptr) shadow_runs->push_back(length);
+        } else if (right - left > options.step_fraction * nearer) {
+          c = MissingClass::kEdge;
+          if (edge_runs != nullptr) edge_runs->push_back(length);
+        } else if (nearer > options.far_m) {
+          c = MissingClass::kRange;
+        } else {
+          c = MissingClass::kLowSignal;
+        }
+      }
+      std::fill(classes.begin() + row + first, classes.begin() + row + u, c);
+    }
+  }
+  return classes;
+}
+
+std::string FormatCauseTable(const std::vector<MissingClass>& classes,
+                             std::span<const MissingCause> causes) {
+  constexpr const char* kClassNames[] = {"valid", "border", "shadow",
+                                         "edge",  "range",  "low signal"};
+  constexpr const char* kCauseNames[] = {"valid",      "border",   "nothing hit", "shadow",
+                                         "low signal", "no match", "ambiguous",   "range"};
+  constexpr int kClasses = 6, kCauses = 8;
+  if (classes.size() != causes.size()) {
+    ThrowBadValue("causes", std::to_string(causes.size()) + " pixels",
+                  std::to_string(classes.size()) + " pixels");
+  }
+  std::vector<double> count(kClasses * kCauses, 0.0);
+  for (size_t p = 0; p < classes.size(); ++p) {
+    count[static_cast<int>(classes[p]) * kCauses + static_cast<int>(causes[p])] += 1;
+  }
+  const double pixels = static_cast<double>(classes.size());
+  std::string text =
+      "missing [% of pixels]: from the depth image (rows) against the sensor's own "
+      "cause (columns)\n";
+  char cell[64];
+  std::snprintf(cell, sizeof(cell), "%-12s", "");
+  text += cell;
+  for (int c = 1; c < kCauses; ++c) {
+    std::snprintf(cell, sizeof(cell), "%12s", kCauseNames[c]);
+    text += cell;
+  }
+  text += "\n";
+  for (int k = 0; k < kClasses; ++k) {
+    std::snprintf(cell, sizeof(cell), "%-12s", kClassNames[k]);
+    text += cell;
+    for (int c = 1; c < kCauses; ++c) {
+      std::snprintf(cell, sizeof(cell), "%12.2f", 100 * count[k * kCauses + c] / pixels);
+      text += cell;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
 ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int width, int height,
                                      const PinholeIntrinsics& intrinsics,
                                      const KinectCalibration& calibration,
@@ -57,40 +132,15 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   ErrorStructure s;
   const double pixels = static_cast<double>(width) * height;
   std::vector<double> shadow_runs, edge_runs;
-  for (int v = 0; v < height; ++v) {
-    const float* row = &depth_m[static_cast<size_t>(v) * width];
-    for (int u = 0; u < width;) {
-      if (Valid(row[u])) {
-        ++u;
-        continue;
-      }
-      const int first = u;
-      while (u < width && !Valid(row[u])) ++u;
-      const double length = u - first;
-      if (first == 0 || u == width) {
-        s.missing_border += length;
-        continue;
-      }
-      const double left = row[first - 1], right = row[u];
-      const double nearer = std::min(left, right);
-      if (left - right > options.step_fraction * nearer) {
-        s.missing_shadow += length;
-        shadow_runs.push_back(length);
-      } else if (right - left > options.step_fraction * nearer) {
-        s.missing_edge += length;
-        edge_runs.push_back(length);
-      } else if (nearer > options.far_m) {
-        s.missing_range += length;
-      } else {
-        s.missing_low_signal += length;
-      }
-    }
-  }
-  s.missing_border /= pixels;
-  s.missing_shadow /= pixels;
-  s.missing_edge /= pixels;
-  s.missing_range /= pixels;
-  s.missing_low_signal /= pixels;
+  const std::vector<MissingClass> classes =
+      ClassifyMissing(depth_m, width, height, options, &shadow_runs, &edge_runs);
+  std::array<double, 6> count{};  // per MissingClass
+  for (const MissingClass c : classes) count[static_cast<int>(c)] += 1;
+  s.missing_border = count[static_cast<int>(MissingClass::kBorder)] / pixels;
+  s.missing_shadow = count[static_cast<int>(MissingClass::kShadow)] / pixels;
+  s.missing_edge = count[static_cast<int>(MissingClass::kEdge)] / pixels;
+  s.missing_range = count[static_cast<int>(MissingClass::kRange)] / pixels;
+  s.missing_low_signal = count[static_cast<int>(MissingClass::kLowSignal)] / pixels;
   s.shadow_band_px = Median(shadow_runs);
   s.edge_band_px = Median(edge_runs);
 
@@ -105,7 +155,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   const Eigen::MatrixXd solve = (design.transpose() * design).inverse() * design.transpose();
   struct Patch {
     Eigen::VectorXd residual;
-    double sigma, model;
+    double sigma, model, incidence_deg;
   };
   std::vector<Patch> patches;
   for (int v0 = 0; v0 + n <= height; v0 += n) {
@@ -115,7 +165,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
       for (int j = 0; j < n && full; ++j) {
         for (int i = 0; i < n; ++i) {
           const float d = depth_m[static_cast<size_t>(v0 + j) * width + u0 + i];
-          if (!Valid(d) || d < options.min_depth_m || d > options.max_depth_m) {
+          if (!ValidDepth(d) || d < options.min_depth_m || d > options.max_depth_m) {
             full = false;
             break;
           }
@@ -136,6 +186,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
       const double step = LatticeStep(zc, calibration);
       const double sigma_z = noise.Sigma(zc, theta);
       p.model = std::sqrt(sigma_z * sigma_z + step * step / 12.0);
+      p.incidence_deg = theta * 180.0 / std::numbers::pi;
       patches.push_back(std::move(p));
     }
   }
@@ -143,11 +194,15 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   for (const Patch& p : patches) sigmas.push_back(p.sigma);
   const double typical = Median(sigmas);
   std::vector<double> numerator(lags + 1, 0.0), ratios;
+  std::array<std::vector<double>, ErrorStructure::kIncidenceBins> ratios_by_incidence;
   double energy = 0;
   for (const Patch& p : patches) {
     if (!(p.sigma <= options.outlier_factor * typical)) continue;
     ++s.patches;
     ratios.push_back(p.sigma / p.model);
+    const int bin = std::min(ErrorStructure::kIncidenceBins - 1,
+                             static_cast<int>(p.incidence_deg / ErrorStructure::kIncidenceBinDeg));
+    ratios_by_incidence[bin].push_back(p.sigma / p.model);
     for (int j = 0; j < n; ++j) {
       for (int i = 0; i < n; ++i) {
         const double r = p.residual[j * n + i];
@@ -160,6 +215,9 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
     }
   }
   s.noise_over_model = Median(ratios);
+  for (int b = 0; b < ErrorStructure::kIncidenceBins; ++b) {
+    s.noise_over_model_by_incidence[b] = Median(ratios_by_incidence[b]);
+  }
   s.autocorrelation.assign(lags, kNaN);
   if (energy > 0) {
     for (int k = 1; k <= lags; ++k) {
@@ -195,6 +253,7 @@ nlohmann::json ToJson(const ErrorStructure& s) {
           {"edge_band_px", s.edge_band_px},
           {"patches", s.patches},
           {"noise_over_model", s.noise_over_model},
+          {"noise_over_model_by_incidence_0_20_40_60_deg", s.noise_over_model_by_incidence},
           {"autocorrelation", s.autocorrelation},
           {"correlation_length_px", s.correlation_length_px}};
 }
@@ -221,6 +280,12 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
       {"shadow band width [px]", [](const ErrorStructure& s) { return s.shadow_band_px; }},
       {"edge band width [px]", [](const ErrorStructure& s) { return s.edge_band_px; }},
       {"small-patch noise / model", [](const ErrorStructure& s) { return s.noise_over_model; }},
+      {"  ... incidence 0-20 deg",
+       [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[0]; }},
+      {"  ... incidence 20-40 deg",
+       [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[1]; }},
+      {"  ... incidence 40-60 deg",
+       [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[2]; }},
       {"residual autocorrelation lag 1",
        [](const ErrorStructure& s) {
          return s.autocorrelation.empty() ? kNaN : s.autocorrelation[0];
@@ -256,7 +321,8 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
   for (const auto& row : rows) {
     for (size_t c = 0; c < row.size(); ++c) widths[c] = std::max(widths[c], row[c].size());
   }
-  for (size_t c = 0; c < header.size(); ++c) widths[c + 1] = std::max(widths[c + 1], header[c].size());
+  for (size_t c = 0; c < header.size(); ++c)
+    widths[c + 1] = std::max(widths[c + 1], header[c].size());
   auto line = [&](const std::vector<std::string>& cells) {
     std::string text = cells[0] + std::string(widths[0] - cells[0].size(), ' ');
     for (size_t c = 1; c < cells.size(); ++c) {
@@ -288,8 +354,9 @@ RgbImage DepthSideBySide(const std::vector<const std::vector<float>*>& depths_m,
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         const float z = depth[static_cast<size_t>(v) * width + u];
-        uint8_t* out = &image.rgb[3 * (static_cast<size_t>(v) * image.width + k * (width + kGap) + u)];
-        if (!Valid(z)) {
+        uint8_t* out =
+            &image.rgb[3 * (static_cast<size_t>(v) * image.width + k * (width + kGap) + u)];
+        if (!ValidDepth(z)) {
           out[0] = 200;
           out[1] = out[2] = 0;
           continue;

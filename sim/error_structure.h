@@ -23,13 +23,17 @@
 // between lags, starting from rho(0) = 1).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "core/camera.h"
 #include "core/image_io.h"
 #include "sim/kinect_model.h"
+#include "sim/structured_light.h"
 
 namespace mmh::sim {
 
@@ -39,7 +43,7 @@ struct ErrorStructureOptions {
   int patch_size = 9;           // odd
   double max_incidence_deg = 60.0;
   double outlier_factor = 3.0;
-  double min_depth_m = 0.4;     // patches outside [min_depth_m, max_depth_m] are left out
+  double min_depth_m = 0.4;  // patches outside [min_depth_m, max_depth_m] are left out
   double max_depth_m = 4.0;
 
   void Validate(const std::string& prefix) const;
@@ -55,6 +59,11 @@ struct ErrorStructure {
   // Median over patches of residual sigma / sqrt(sigma_z^2 + step^2 / 12) (AxialNoiseModel,
   // LatticeStep): the small-patch noise relative to the per-pixel model.
   double noise_over_model = 0;
+  // The same per incidence angle of the patch's plane: [0, 20), [20, 40), [40, 60] deg (NaN: no
+  // patch); kIncidenceBins of kIncidenceBinDeg each.
+  static constexpr int kIncidenceBins = 3;
+  static constexpr double kIncidenceBinDeg = 20.0;
+  std::array<double, kIncidenceBins> noise_over_model_by_incidence{};
   std::vector<double> autocorrelation;  // rho(1) .. rho(patch_size / 2)
   double correlation_length_px = 0;
 };
@@ -67,6 +76,21 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
                                      const ErrorStructureOptions& options = {});
 
 nlohmann::json ToJson(const ErrorStructure& structure);
+
+// Why a pixel is missing, judged from the depth image alone (real frames carry no labels): runs of
+// missing pixels along a row touching the image's side (border), with the far side on their left
+// (shadow: the projector sits to the right) or on their right (edge), between neighbours beyond
+// far_m (range), otherwise low signal. Run lengths of shadow and edge runs appended when given.
+enum class MissingClass : uint8_t { kValid = 0, kBorder, kShadow, kEdge, kRange, kLowSignal };
+std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width, int height,
+                                          const ErrorStructureOptions& options = {},
+                                          std::vector<double>* shadow_runs = nullptr,
+                                          std::vector<double>* edge_runs = nullptr);
+
+// The classes against a rendered frame's exact causes (KinectSensor::missing_causes), in % of all
+// pixels: how well the depth-image rules that classify real frames name the sensor's causes.
+std::string FormatCauseTable(const std::vector<MissingClass>& classes,
+                             std::span<const MissingCause> causes);
 
 // Real against rendered: one row per statistic, a column per named structure, then the ratio of
 // each rendered column (indices `rendered`) to the real one (index `reference`), and the goal

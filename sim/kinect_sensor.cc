@@ -311,7 +311,7 @@ struct KinectSensor::Impl {
   std::vector<const uint8_t*> face_colors;  // per object
   std::vector<float> object_ir_diffuse, object_ir_specular;  // per object (SurfaceMaterial)
   std::unique_ptr<internal::SpeckleMatcher> speckle;  // structured-light mode
-  std::vector<float> ir_image;                         // structured-light mode, depth view
+  std::vector<uint16_t> ir_image;                      // structured-light mode, depth view
   std::vector<MissingCause> last_causes;     // when requested (KeepMissingCauses)
   std::vector<std::vector<uint8_t>> static_face_storage;
   std::vector<const uint8_t*> static_face_color;  // per object (ShadeStaticFaces)

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "sim/internal/depth_sample.h"
 #include "core/options.h"
 
 namespace mmh::sim {
@@ -19,18 +20,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Median of a copy (NaN when empty); the mean of the two middle values for an even count.
-double Median(std::vector<double> values) {
-  if (values.empty()) return kNaN;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  const double lower = *std::max_element(values.begin(), values.begin() + mid);
-  return 0.5 * (lower + upper);
-}
-
-bool Valid(float z) { return std::isfinite(z) && z > 0; }
+using internal::Median;
+using internal::ValidDepth;
 
 bool InRange(double z, const SensorCheckOptions& options) {
   return z >= options.min_depth_m && z <= options.max_depth_m;
@@ -115,7 +106,7 @@ void SensorCheckOptions::Validate(const std::string& prefix) const {
 double MissingFraction(const std::vector<float>& depth_m) {
   if (depth_m.empty()) return 0.0;
   const auto missing =
-      std::count_if(depth_m.begin(), depth_m.end(), [](float z) { return !Valid(z); });
+      std::count_if(depth_m.begin(), depth_m.end(), [](float z) { return !ValidDepth(z); });
   return static_cast<double>(missing) / depth_m.size();
 }
 
@@ -126,7 +117,7 @@ DepthStepLaw FitDepthStepLaw(const std::vector<float>& depth_m, const SensorChec
   law.fundamental_k = kNaN;
   std::vector<double> distinct;
   for (float z : depth_m) {
-    if (Valid(z) && InRange(z, options)) distinct.push_back(z);
+    if (ValidDepth(z) && InRange(z, options)) distinct.push_back(z);
   }
   std::sort(distinct.begin(), distinct.end());
   distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
@@ -237,7 +228,7 @@ std::vector<NoiseBin> EstimatePatchNoise(const std::vector<float>& depth_m, int 
       for (int dv = -half; dv <= half && complete; ++dv) {
         for (int du = -half; du <= half; ++du) {
           const float z = depth_m[static_cast<size_t>(v0 + dv) * width + (u0 + du)];
-          if (!Valid(z) || !InRange(z, options)) {
+          if (!ValidDepth(z) || !InRange(z, options)) {
             complete = false;
             break;
           }
@@ -356,7 +347,7 @@ SensorStatistics ComputeSensorStatistics(const std::string& name, const std::vec
   stats.missing_fraction = MissingFraction(depth_m);
   std::vector<double> valid;
   for (float z : depth_m) {
-    if (Valid(z)) valid.push_back(z);
+    if (ValidDepth(z)) valid.push_back(z);
   }
   stats.valid_pixels = static_cast<int>(valid.size());
   if (valid.empty()) {

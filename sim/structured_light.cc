@@ -31,8 +31,9 @@ void StructuredLightOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(ambient, prefix + ".ambient");
   RequireNonNegative(read_noise, prefix + ".read_noise");
   RequireNonNegative(shot_gain, prefix + ".shot_gain");
-  if (adc_bits < 4 || adc_bits > 16) {
-    ThrowBadValue(prefix + ".adc_bits", std::to_string(adc_bits), "an integer in [4, 16]");
+  if (adc_bits < 4 || adc_bits > 12) {
+    ThrowBadValue(prefix + ".adc_bits", std::to_string(adc_bits),
+                  "an integer in [4, 12] (the Kinect's IR camera: 10)");
   }
   if (!(specular_exponent >= 0 && specular_exponent <= 1000) ||
       specular_exponent != std::floor(specular_exponent)) {
@@ -42,6 +43,14 @@ void StructuredLightOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(specular_gain, prefix + ".specular_gain");
   if (window_px < 3 || window_px > 31 || window_px % 2 == 0) {
     ThrowBadValue(prefix + ".window_px", std::to_string(window_px), "an odd size in [3, 31] px");
+  }
+  // The block matcher sums window products of ADC counts in 32-bit integers (exact).
+  const double largest = static_cast<double>(window_px) * window_px *
+                         std::pow(static_cast<double>((1 << adc_bits) - 1), 2);
+  if (largest > 2147483647.0) {
+    ThrowBadValue(prefix + ".window_px", std::to_string(window_px),
+                  "a window whose pixel count times (2^adc_bits - 1)^2 stays below 2^31 (adc_bits " +
+                      std::to_string(adc_bits) + ")");
   }
   if (search_px < 1 || search_px > 16) {
     ThrowBadValue(prefix + ".search_px", std::to_string(search_px), "an integer in [1, 16] px");

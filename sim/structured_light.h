@@ -44,7 +44,8 @@ struct StructuredLightOptions {
   // The IR image, full scale 1: a dot of brightness 1 on a white Lambertian surface facing the
   // camera at 1 m peaks at projector_power (fall-off 1 / z^2), ambient IR light reflected by the
   // surface adds ambient * albedo; sensor noise sigma^2 = read_noise^2 + shot_gain * value;
-  // values clip at full scale and are quantised to adc_bits.
+  // values clip at full scale and are quantised to adc_bits (at most 12; window_px^2 (2^adc_bits -
+  // 1)^2 below 2^31: the matcher's sums are exact 32-bit integers).
   double projector_power = 0.6;
   double ambient = 0.02;
   double read_noise = 0.004;
@@ -67,6 +68,13 @@ struct StructuredLightOptions {
   double min_correlation = 0.5;
   double min_contrast = 0.005;
   double ambiguity_ratio = 0.95;
+  // Diagnostics (docs/tracker.md, "Structured-light frames"), both true on a real device:
+  // edge_candidates false searches only around the disparity at the window's centre (no edge
+  // fattening from the sides' surfaces); parabola_subpixel false reports the rendered disparity
+  // where the integer match lies within a pixel of it (no pixel locking, no sub-pixel noise; the
+  // integer match, its rejections and the matches to other surfaces stay).
+  bool edge_candidates = true;
+  bool parabola_subpixel = true;
 
   template <class V>
   void VisitFields(V& v) {
@@ -85,6 +93,8 @@ struct StructuredLightOptions {
     v("min_correlation", min_correlation);
     v("min_contrast", min_contrast);
     v("ambiguity_ratio", ambiguity_ratio);
+    v("edge_candidates", edge_candidates);
+    v("parabola_subpixel", parabola_subpixel);
   }
   void Validate(const std::string& prefix) const;
 };

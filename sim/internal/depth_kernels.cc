@@ -63,6 +63,17 @@ template void DepthRowPortable<false>(const DepthParams&, const float*, const fl
                                       const uint32_t*, const float*, int, int, uint8_t*,
                                       uint16_t*);
 
+void DepthNoise(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
+                float* normal) {
+#if MMH_SENSOR_AVX512
+  if (UseAvx512().load(std::memory_order_relaxed)) {
+    DepthNoiseAvx512(q, first_pixel, n, drop_bits, normal);
+    return;
+  }
+#endif
+  DepthNoisePortable(q, first_pixel, n, drop_bits, normal);
+}
+
 template <bool kQuantise>
 void DepthRow(const DepthParams& q, const float* up, const float* row, const float* down,
               const float* depth, const float* cos_incidence, const uint8_t* occluded,

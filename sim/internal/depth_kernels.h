@@ -66,6 +66,9 @@ inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, 
 // key_b hash of k as their dropout uniforms.
 void DepthNoisePortable(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
                         float* normal);
+// DepthNoisePortable or its AVX-512 kernel where enabled (UseAvx512): the same numbers.
+void DepthNoise(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
+                float* normal);
 
 // A row of depth pixels [first, n): whether each is kept (something hit, not occluded) and an
 // edge (largest 4-neighbour disparity difference above edge_jump; outside the image counts as

@@ -2,12 +2,15 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/simd.h"
 #include "sim/internal/counter_random.h"
+#include "sim/internal/depth_kernels.h"
 
 namespace mmh::sim::internal {
 namespace {
@@ -15,29 +18,372 @@ namespace {
 // A uniform in [0, 1) from 53 bits of a 64-bit hash.
 double Uniform(uint64_t h) { return static_cast<double>(h >> 11) * (1.0 / 9007199254740992.0); }
 
-// x^n for a whole n >= 0 by repeated squaring (std::pow costs about 20 times more per pixel).
-float WholePower(float x, int n) {
-  float result = 1.0f;
-  while (n > 0) {
-    if (n & 1) result *= x;
-    x *= x;
-    n >>= 1;
+// Pixels are matched in tiles of kBand rows by kSegment columns: each tile scores only the
+// integer disparities its pixels' searches need, its column products slide down the rows.
+constexpr int kSegment = 64;
+constexpr int kBand = 8;
+
+// The IR image's constants as floats for the vector loop.
+struct IrParams {
+  float power = 0, ambient = 0, read2 = 0, shot = 0, levels = 0, gain = 0;
+  float x_min = 0;          // the pattern's first column
+  float last_position = 0;  // the last pattern sample with a right neighbour
+};
+
+// The glare's lobe: out[k] = c[k]^exponent by repeated squaring (whole exponent >= 0; std::pow
+// costs about 20 times more), a pass over the row per bit so that the loops vectorise, 0 in the
+// IR shadow; x: #n scratch.
+MMH_SIMD_CLONES void GlareRow(const float* __restrict c, const uint8_t* __restrict occluded,
+                              int exponent, int n, float* __restrict x, float* __restrict out) {
+  for (int k = 0; k < n; ++k) {
+    out[k] = 1.0f;
+    x[k] = c[k];
   }
-  return result;
+  for (int e = exponent; e > 0; e >>= 1) {
+    if (e & 1) {
+      for (int k = 0; k < n; ++k) out[k] *= x[k];
+    }
+    for (int k = 0; k < n; ++k) x[k] *= x[k];
+  }
+  for (int k = 0; k < n; ++k) out[k] *= static_cast<float>(occluded[k] == 0);
 }
 
-// Pixels are matched in segments of this many columns: each segment scores only the integer
-// disparities its windows' rendered disparities can reach.
-constexpr int kSegment = 64;
+// One row of the IR image in ADC counts (docs/sensor.md, "Structured light", step 2): the
+// pattern at column u - d (linear between 1/8 px samples of `pattern`), Lambertian return,
+// glare (cos^n precomputed), 1 / z^2 fall-off, ambient light, sensor noise (normal: standard
+// normals), clip, quantisation.
+MMH_SIMD_CLONES void IrRow(const IrParams& p, const float* __restrict pattern,
+                           const float* __restrict depth, const float* __restrict disparity,
+                           const float* __restrict cos_incidence,
+                           const uint8_t* __restrict occluded, const float* __restrict diffuse,
+                           const float* __restrict specular, const float* __restrict glare,
+                           const float* __restrict normal, int n, float* __restrict dots,
+                           uint16_t* __restrict ir) {
+  const float x_min = p.x_min, last_position = p.last_position;
+  for (int u = 0; u < n; ++u) {
+    float position = (static_cast<float>(u) - disparity[u] - x_min) * 8.0f;
+    position = position > 0.0f ? position : 0.0f;
+    position = position < last_position ? position : last_position;
+    const int k = static_cast<int>(position);
+    const float t = position - static_cast<float>(k);
+    // The pattern reaches the point from the projector unless something is in between (the IR
+    // shadow). (Selections as products with 0 or 1 so that the loops vectorise.)
+    dots[u] =
+        (pattern[k] + t * (pattern[k + 1] - pattern[k])) * static_cast<float>(occluded[u] == 0);
+  }
+  const float power = p.power, ambient = p.ambient, read2 = p.read2, shot = p.shot,
+              levels = p.levels, gain = p.gain;
+  for (int u = 0; u < n; ++u) {
+    const float d = disparity[u];
+    const bool hit = d != 0.0f;
+    // A Lambertian surface returns the pattern; a mirror-like one returns glare without the
+    // dots (none in the IR shadow: glare[u] is 0 there).
+    const float returned = dots[u] * diffuse[u] * cos_incidence[u] + specular[u] * gain * glare[u];
+    // Pixels that see nothing get a harmless depth so that the arithmetic stays finite.
+    const float z = hit ? depth[u] : 1.0f;
+    float signal = power * returned / (z * z) + ambient * (diffuse[u] + specular[u]);
+    signal = hit ? signal : 0.0f;
+    const float value = signal + std::sqrt(read2 + shot * signal) * normal[u];
+    float clipped = value > 0.0f ? value : 0.0f;
+    clipped = clipped < 1.0f ? clipped : 1.0f;
+    ir[u] = static_cast<uint16_t>(static_cast<int>(std::floor(clipped * levels + 0.5f)));
+  }
+}
+
+// Window sums down the columns: sum[k] = sum_j a[j stride + k], square[k] likewise of a^2, over
+// `rows` rows (exact: ADC counts, MatchableWindow).
+MMH_SIMD_CLONES void ColumnSums(const int32_t* __restrict a, size_t stride, int rows, int n,
+                                int32_t* __restrict sum, int32_t* __restrict square) {
+  for (int k = 0; k < n; ++k) {
+    sum[k] = 0;
+    square[k] = 0;
+  }
+  for (int j = 0; j < rows; ++j) {
+    const int32_t* __restrict row = a + static_cast<size_t>(j) * stride;
+    for (int k = 0; k < n; ++k) {
+      const int32_t x = row[k];
+      sum[k] += x;
+      square[k] += x * x;
+    }
+  }
+}
+
+// Column products are computed in blocks of this many (the vector loops then need no
+// remainder; the IR rows and the reference are padded).
+constexpr int kBlock = 16;
+int RoundUp(int n) { return (n + kBlock - 1) / kBlock * kBlock; }
+
+// out[k] = sum_j a[j a_stride + k] b[j b_stride + k] over `rows` rows (exact), n a multiple of
+// kBlock.
+MMH_SIMD_CLONES void ColumnProducts(const int32_t* __restrict a, size_t a_stride,
+                                    const int32_t* __restrict b, size_t b_stride, int rows, int n,
+                                    int32_t* __restrict out) {
+  for (int k = 0; k < n; ++k) out[k] = 0;
+  for (int j = 0; j < rows; ++j) {
+    const int32_t* __restrict aj = a + static_cast<size_t>(j) * a_stride;
+    const int32_t* __restrict bj = b + static_cast<size_t>(j) * b_stride;
+    for (int base = 0; base < n; base += kBlock) {
+      for (int k = base; k < base + kBlock; ++k) out[k] += aj[k] * bj[k];
+    }
+  }
+}
+
+// Moves column products one row down: sums[k] += a_in[k] b_in[k] - a_out[k] b_out[k] (exact), n a
+// multiple of kBlock.
+MMH_SIMD_CLONES void SlideProducts(const int32_t* __restrict a_in, const int32_t* __restrict b_in,
+                                   const int32_t* __restrict a_out, const int32_t* __restrict b_out,
+                                   int n, int32_t* __restrict sums) {
+  for (int base = 0; base < n; base += kBlock) {
+    for (int k = base; k < base + kBlock; ++k) {
+      sums[k] += a_in[k] * b_in[k] - a_out[k] * b_out[k];
+    }
+  }
+}
+
+// The IR window's rows as 32-bit integers, each padded with kBlock zeros.
+MMH_SIMD_CLONES void WidenRows(const uint16_t* __restrict ir, int width, int rows,
+                               int32_t* __restrict out) {
+  const int stride = width + kBlock;
+  for (int j = 0; j < rows; ++j) {
+    for (int k = 0; k < width; ++k) out[j * stride + k] = ir[j * width + k];
+    for (int k = width; k < stride; ++k) out[j * stride + k] = 0;
+  }
+}
+
+// out[k] = sum_{i < window} in[k + i] (exact), by doubling: sums of 1, 2, 4, ... consecutive
+// values, those of window's binary digits added up (5 passes for 9 instead of 9); a and b:
+// scratch of n + window.
+MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n, int32_t* __restrict a,
+                             int32_t* __restrict b, int32_t* __restrict out) {
+  const int total = n + window - 1;
+  const int32_t* sums = in;  // sums of `width` consecutive values, valid for k < total - width + 1
+  int32_t* next = a;
+  int offset = 0;
+  for (int width = 1;; width *= 2) {
+    if (window & width) {
+      if (offset == 0) {
+        for (int k = 0; k < n; ++k) out[k] = sums[k];
+      } else {
+        for (int k = 0; k < n; ++k) out[k] += sums[k + offset];
+      }
+      offset += width;
+    }
+    if (2 * width > window) break;
+    const int valid = total - 2 * width + 1;
+    for (int k = 0; k < valid; ++k) next[k] = sums[k] + sums[k + width];
+    sums = next;
+    next = next == a ? b : a;
+  }
+}
+
+// Zero-mean normalised cross-correlation of windows of `count` pixels from their sums at
+// disparity d: (count cross - sum_a sum_b) / sqrt((count sq_a - sum_a^2) (count sq_b - sum_b^2)),
+// with the inverse square roots given (the numerator is an integer below 2^53: exact in double);
+// then each pixel's best score over the disparities of its search [first, last] and the scores
+// beside it (for the parabola): called for each d in increasing order (ties keep the smaller d;
+// previous: the scores at d - 1).
+MMH_SIMD_CLONES void ScoreAndTakeBest(
+    const int32_t* __restrict cross, const int32_t* __restrict sum_a,
+    const double* __restrict inverse_a, const int32_t* __restrict sum_b,
+    const double* __restrict inverse_b, double count, int d, const int* __restrict first,
+    const int* __restrict last, int n, const double* __restrict previous, double* __restrict score,
+    double* __restrict best, int* __restrict best_d, double* __restrict left,
+    double* __restrict right) {
+  for (int k = 0; k < n; ++k) {
+    const double numerator = count * static_cast<double>(cross[k]) -
+                             static_cast<double>(sum_a[k]) * static_cast<double>(sum_b[k]);
+    const double x = numerator * inverse_a[k] * inverse_b[k];
+    score[k] = x;
+    right[k] = d == best_d[k] + 1 ? x : right[k];
+    const bool better = (d >= first[k]) & (d <= last[k]) & (x > best[k]);
+    best[k] = better ? x : best[k];
+    best_d[k] = better ? d : best_d[k];
+    left[k] = better ? previous[k] : left[k];
+  }
+}
+
+// The best score at least two pixels from the peak (the ambiguity test).
+MMH_SIMD_CLONES void TakeSecond(const double* __restrict score, int d, const int* __restrict first,
+                                const int* __restrict last, const int* __restrict best_d, int n,
+                                double* __restrict second) {
+  for (int k = 0; k < n; ++k) {
+    const int distance = d - best_d[k];
+    const bool take = (d >= first[k]) & (d <= last[k]) & ((distance >= 2) | (distance <= -2)) &
+                      (score[k] > second[k]);
+    second[k] = take ? score[k] : second[k];
+  }
+}
+
+// 1 / sqrt(n square - sum^2) of the IR windows, 0 where that is below min_norm2 (low signal).
+MMH_SIMD_CLONES void InverseNorms(const int32_t* __restrict sum, const int32_t* __restrict square,
+                                  double count, double min_norm2, int n,
+                                  double* __restrict inverse_norm) {
+  for (int k = 0; k < n; ++k) {
+    const double norm2 = count * static_cast<double>(square[k]) -
+                         static_cast<double>(sum[k]) * static_cast<double>(sum[k]);
+    const bool low = !(norm2 >= min_norm2) | (norm2 <= 0.0);
+    inverse_norm[k] = low ? 0.0 : 1.0 / std::sqrt(norm2);
+  }
+}
+
+// The integer disparity at which each pixel's search is centred: the rendered disparity rounded,
+// at most `largest` (-1: nothing hit; in `low` a large number instead of -1).
+MMH_SIMD_CLONES void Centres(const float* __restrict disparity, int largest, size_t n,
+                             int* __restrict centre, int* __restrict low) {
+  for (size_t p = 0; p < n; ++p) {
+    const int rounded = static_cast<int>(std::floor(disparity[p] + 0.5f));
+    const int c = disparity[p] != 0.0f ? std::min(largest, rounded) : -1;
+    centre[p] = c;
+    low[p] = c < 0 ? std::numeric_limits<int>::max() / 2 : c;
+  }
+}
+
+// Why a pixel is not searched before its window is looked at: nothing hit, or IR shadow.
+MMH_SIMD_CLONES void GeometryBlocked(const int* __restrict centre,
+                                     const uint8_t* __restrict occluded, size_t n,
+                                     int* __restrict blocked) {
+  for (size_t p = 0; p < n; ++p) {
+    const int shadow = occluded[p] != 0 ? static_cast<int>(MissingCause::kShadow) : 0;
+    blocked[p] = centre[p] < 0 ? static_cast<int>(MissingCause::kNothing) : shadow;
+  }
+}
+
+// Why a pixel is not searched (0: it is): nothing hit, IR shadow, low signal.
+MMH_SIMD_CLONES void WindowBlocked(const int* __restrict blocked,
+                                   const double* __restrict inverse_norm, int n,
+                                   int* __restrict pre) {
+  for (int k = 0; k < n; ++k) {
+    const int low = inverse_norm[k] == 0.0 ? static_cast<int>(MissingCause::kLowSignal) : 0;
+    pre[k] = blocked[k] != 0 ? blocked[k] : low;
+  }
+}
+
+// Each pixel's search [first, last]: within `search` of the smallest and largest search centre
+// at the window's centre and the middles of its sides (low: centres with "nothing hit" as a
+// large number; high: as -1), or none (first > last) where pre is not 0.
+MMH_SIMD_CLONES void SearchRanges(const int* __restrict low, const int* __restrict low_up,
+                                  const int* __restrict low_down, const int* __restrict high,
+                                  const int* __restrict high_up, const int* __restrict high_down,
+                                  const int* __restrict pre, int side, int search, int max_d, int n,
+                                  int* __restrict first, int* __restrict last) {
+  for (int k = 0; k < n; ++k) {
+    const int a = std::min(
+        std::min(std::min(low[k], low[k - side]), std::min(low[k + side], low_up[k])), low_down[k]);
+    const int b =
+        std::max(std::max(std::max(high[k], high[k - side]), std::max(high[k + side], high_up[k])),
+                 high_down[k]);
+    first[k] = pre[k] == 0 ? std::max(0, a - search) : std::numeric_limits<int>::max();
+    last[k] = pre[k] == 0 ? std::min(max_d, b + search) : -1;
+  }
+}
+
+// The verdict on each pixel of a segment (docs/sensor.md, "Structured light", step 4) as a
+// MissingCause, and its disparity: the vertex of the parabola through the peak and its
+// neighbours.
+MMH_SIMD_CLONES void Decide(const double* __restrict best, const int* __restrict best_d,
+                            const double* __restrict second, const double* __restrict left,
+                            const double* __restrict right, const int* __restrict first,
+                            const int* __restrict last, const int* __restrict pre,
+                            double min_correlation, double ambiguity, int n, int* __restrict code,
+                            float* __restrict disparity) {
+  for (int k = 0; k < n; ++k) {
+    const double peak = best[k];
+    const int d = best_d[k];
+    const bool no_match = (peak < min_correlation) | (d == first[k]) | (d == last[k]);
+    const bool ambiguous = second[k] > ambiguity * peak;
+    // Three-point Gaussian fit (the vertex of the parabola through the logarithms): the
+    // correlation peak of Gaussian speckle dots is Gaussian, and a parabola through the scores
+    // themselves pulls the disparity towards whole pixels (pixel locking, which real Kinect
+    // frames do not show: docs/sensor.md). A parabola where a score is not positive.
+    const bool positive = (left[k] > 0.0) & (peak > 0.0) & (right[k] > 0.0);
+    const double l = positive ? static_cast<double>(LnUnit(static_cast<float>(left[k]))) : left[k];
+    const double m = positive ? static_cast<double>(LnUnit(static_cast<float>(peak))) : peak;
+    const double r =
+        positive ? static_cast<double>(LnUnit(static_cast<float>(right[k]))) : right[k];
+    const double curvature = l - 2.0 * m + r;
+    double offset = curvature < 0.0 ? 0.5 * (l - r) / curvature : 0.0;
+    offset = offset > -0.5 ? offset : -0.5;
+    offset = offset < 0.5 ? offset : 0.5;
+    disparity[k] = static_cast<float>(d + offset);
+    int c = ambiguous ? static_cast<int>(MissingCause::kAmbiguous) : 0;
+    c = no_match ? static_cast<int>(MissingCause::kNoMatch) : c;
+    code[k] = pre[k] != 0 ? pre[k] : c;
+  }
+}
+
+// Depth units of matched pixels on the raw lattice (raw = round(raw_offset - 8 d), units from
+// the table, 0 outside [0, 2046] or the depth range: kRange); other pixels keep their code.
+MMH_SIMD_CLONES void LatticeDepth(const SpeckleOutput& output, const int32_t* __restrict table,
+                                  const int* __restrict code, const float* __restrict disparity,
+                                  int n, int32_t* __restrict units, int32_t* __restrict why) {
+  const float raw_offset = output.raw_offset, steps = output.subpixel_steps;
+  for (int k = 0; k < n; ++k) {
+    // Index 2047 (table entry 0): off the lattice (raw < 0 or > 2046) or not matched; written
+    // with min, max and bit masks, which GCC vectorises.
+    float raw = std::floor(raw_offset - steps * disparity[k] + 0.5f);
+    raw = std::max(-1.0f, std::min(raw, 2047.0f));
+    const int index = (static_cast<int>(raw) | (code[k] != 0 ? 2047 : 0)) & 2047;
+    units[k] = table[index];
+  }
+  for (int k = 0; k < n; ++k) {
+    why[k] = code[k] != 0 ? code[k] : units[k] != 0 ? 0 : static_cast<int>(MissingCause::kRange);
+  }
+}
 
 }  // namespace
 
+// Per task: a band's searches and window statistics (kBand rows), a segment's running column
+// products and scores.
+struct SpeckleMatcher::BandScratch {
+  explicit BandScratch(int width)
+      : first(kBand * width),
+        last(kBand * width),
+        pre(kBand * width),
+        sum(kBand * width),
+        inverse_norm(kBand * width),
+        column_sum(width),
+        column_square(width),
+        square(width),
+        box_a(width + kBlock + 32),
+        box_b(width + kBlock + 32),
+        cross(kSegment),
+        code(kSegment),
+        disparity(kSegment),
+        best(kSegment),
+        second(kSegment),
+        left(kSegment),
+        right(kSegment),
+        none(kSegment, 0.0),
+        best_d(kSegment) {}
+  // Per row of the band (r width + u):
+  std::vector<int> first, last;      // the search [first, last] (first > last: none)
+  std::vector<int> pre;              // why a pixel is not searched (MissingCause; 0: it is)
+  std::vector<int32_t> sum;          // the IR window's sum
+  std::vector<double> inverse_norm;  // 1 / sqrt(n sum of squares - sum^2); 0: low signal
+  // Per row:
+  std::vector<int32_t> column_sum, column_square, square;
+  std::vector<int32_t> box_a, box_b;  // BoxSums' scratch
+  // Per segment:
+  std::vector<int32_t> products;  // window column products, (d - lo) stride + k
+  std::vector<int32_t> cross;
+  std::vector<double> scores;    // (d - lo) kSegment + k
+  std::vector<int> code;         // the verdict (MissingCause) per pixel
+  std::vector<float> disparity;  // the matched disparity per pixel
+  std::vector<double> best, second, left, right;
+  std::vector<double> none;  // the "scores at d - 1" of the first disparity (never used)
+  std::vector<int> best_d;
+};
+
 SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width, int height,
                                double max_disparity)
-    : options_(options), width_(width), height_(height), radius_(options.window_px / 2) {
+    : options_(options),
+      width_(width),
+      height_(height),
+      radius_(options.window_px / 2),
+      levels_((1 << options.adc_bits) - 1) {
   max_d_ = static_cast<int>(std::ceil(max_disparity)) + options.search_px + 2;
   x_min_ = -max_d_ - radius_ - 2;
-  const int x_max = width + radius_ + 2;
+  const int x_max = width + radius_ + 2 + kBlock;  // kBlock: ColumnProducts' padding
   columns_ = x_max - x_min_ + 1;
   samples_ = columns_ * kSubsamples + 1;
   pattern_.assign(static_cast<size_t>(height) * samples_, 0.0f);
@@ -49,7 +395,8 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
   const double reach = 3.0 * sigma;
   const double x0 = x_min_ - reach, x1 = x_max + reach;
   const double y0 = -reach, y1 = height + reach;
-  const auto dots = static_cast<uint64_t>(std::llround(options.dot_density * (x1 - x0) * (y1 - y0)));
+  const auto dots =
+      static_cast<uint64_t>(std::llround(options.dot_density * (x1 - x0) * (y1 - y0)));
   const double inverse_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
   for (uint64_t i = 0; i < dots; ++i) {
     const uint64_t key = Mix64(options.pattern_seed ^ Mix64(3 * i + 0x9E3779B97F4A7C15ULL));
@@ -58,7 +405,8 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
     const double brightness = 0.5 + 0.5 * Uniform(Mix64(key + 2));
     const int row_first = std::max(0, static_cast<int>(std::ceil(y - reach)));
     const int row_last = std::min(height - 1, static_cast<int>(std::floor(y + reach)));
-    const int k_first = std::max(0, static_cast<int>(std::ceil((x - reach - x_min_) * kSubsamples)));
+    const int k_first =
+        std::max(0, static_cast<int>(std::ceil((x - reach - x_min_) * kSubsamples)));
     const int k_last =
         std::min(samples_ - 1, static_cast<int>(std::floor((x + reach - x_min_) * kSubsamples)));
     for (int r = row_first; r <= row_last; ++r) {
@@ -71,36 +419,52 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
     }
   }
 
-  // The reference image (integer columns) and its window statistics.
+  // The reference image: the pattern at integer columns, captured by the same camera (ADC
+  // counts; scaled so that the brightest sample is full scale: ZNCC does not see the scale).
+  float peak = 0.0f;
+  for (const float x : pattern_) peak = std::max(peak, x);
+  const double scale = peak > 0.0f ? levels_ / static_cast<double>(peak) : 0.0;
   reference_.resize(static_cast<size_t>(height) * columns_);
   for (int v = 0; v < height; ++v) {
     for (int c = 0; c < columns_; ++c) {
-      reference_[static_cast<size_t>(v) * columns_ + c] =
-          pattern_[static_cast<size_t>(v) * samples_ + static_cast<size_t>(c) * kSubsamples];
+      reference_[static_cast<size_t>(v) * columns_ + c] = static_cast<int32_t>(std::lround(
+          scale *
+          pattern_[static_cast<size_t>(v) * samples_ + static_cast<size_t>(c) * kSubsamples]));
     }
   }
-  reference_sum_.assign(reference_.size(), 0.0f);
-  reference_inverse_norm_.assign(reference_.size(), 0.0f);
-  const int n = options.window_px * options.window_px;
+  // Its window statistics (exact integer sums).
+  reference_sum_.assign(reference_.size(), 0);
+  reference_inverse_norm_.assign(reference_.size(), 0.0);
+  const int window = options.window_px;
+  const int64_t n = static_cast<int64_t>(window) * window;
+  std::vector<int64_t> column_sum(columns_), column_square(columns_);
   for (int v = radius_; v < height - radius_; ++v) {
-    for (int c = radius_; c < columns_ - radius_; ++c) {
-      double s1 = 0, s2 = 0;
-      for (int j = -radius_; j <= radius_; ++j) {
-        const float* row = &reference_[static_cast<size_t>(v + j) * columns_];
-        for (int i = -radius_; i <= radius_; ++i) {
-          s1 += row[c + i];
-          s2 += static_cast<double>(row[c + i]) * row[c + i];
-        }
+    std::fill(column_sum.begin(), column_sum.end(), 0);
+    std::fill(column_square.begin(), column_square.end(), 0);
+    for (int j = -radius_; j <= radius_; ++j) {
+      const int32_t* row = &reference_[static_cast<size_t>(v + j) * columns_];
+      for (int c = 0; c < columns_; ++c) {
+        column_sum[c] += row[c];
+        column_square[c] += static_cast<int64_t>(row[c]) * row[c];
       }
-      const double norm2 = s2 - s1 * s1 / n;
+    }
+    for (int c = radius_; c < columns_ - radius_; ++c) {
+      int64_t s1 = 0, s2 = 0;
+      for (int i = -radius_; i <= radius_; ++i) {
+        s1 += column_sum[c + i];
+        s2 += column_square[c + i];
+      }
+      const int64_t norm2 = n * s2 - s1 * s1;
       const size_t at = static_cast<size_t>(v) * columns_ + c;
-      reference_sum_[at] = static_cast<float>(s1);
-      reference_inverse_norm_[at] = norm2 > 0 ? static_cast<float>(1.0 / std::sqrt(norm2)) : 0.0f;
+      reference_sum_[at] = static_cast<int32_t>(s1);
+      reference_inverse_norm_[at] = norm2 > 0 ? 1.0 / std::sqrt(static_cast<double>(norm2)) : 0.0;
     }
   }
 }
 
-float SpeckleMatcher::Reference(int x, int v) const {
+SpeckleMatcher::~SpeckleMatcher() = default;
+
+int SpeckleMatcher::Reference(int x, int v) const {
   return reference_[static_cast<size_t>(v) * columns_ + (x - x_min_)];
 }
 
@@ -113,217 +477,240 @@ float SpeckleMatcher::Pattern(float x, int v) const {
   return row[k] + t * (row[k + 1] - row[k]);
 }
 
-void SpeckleMatcher::RenderIr(const SpeckleScene& scene, uint32_t key, float* ir) const {
-  const auto power = static_cast<float>(options_.projector_power);
-  const auto ambient = static_cast<float>(options_.ambient);
-  const auto read2 = static_cast<float>(options_.read_noise * options_.read_noise);
-  const auto shot = static_cast<float>(options_.shot_gain);
-  const auto levels = static_cast<float>((1 << options_.adc_bits) - 1);
+int SpeckleMatcher::SearchCentre(float disparity) const {
+  int centre, low;
+  Centres(&disparity, max_d_ - options_.search_px - 2, 1, &centre, &low);
+  return centre;
+}
+
+void SpeckleMatcher::RenderIr(const SpeckleScene& scene, uint32_t key, uint16_t* ir) const {
+  IrParams p;
+  p.power = static_cast<float>(options_.projector_power);
+  p.ambient = static_cast<float>(options_.ambient);
+  p.read2 = static_cast<float>(options_.read_noise * options_.read_noise);
+  p.shot = static_cast<float>(options_.shot_gain);
+  p.levels = static_cast<float>(levels_);
+  p.gain = static_cast<float>(options_.specular_gain);
+  p.x_min = static_cast<float>(x_min_);
+  p.last_position = static_cast<float>(samples_ - 2);
   const auto exponent = static_cast<int>(options_.specular_exponent);
-  const auto gain = static_cast<float>(options_.specular_gain);
+  // Sensor noise: pixels 2k and 2k + 1 take the two normals of the Box-Muller pair k (the depth
+  // model's generator, keyed by `key`).
+  DepthParams noise;
+  noise.key_c = key;
   tbb::parallel_for(tbb::blocked_range<int>(0, height_, 16), [&](const tbb::blocked_range<int>& r) {
+    const int w = width_;
+    std::vector<float> normal(w), glare(w), scratch(w), dots(w);
+    std::vector<uint32_t> unused(w);
     for (int v = r.begin(); v != r.end(); ++v) {
-      const size_t row = static_cast<size_t>(v) * width_;
-      // Sensor noise: pixels 2k and 2k + 1 take the two normals of pair k.
-      float normal[2] = {0.0f, 0.0f};
-      for (int u = 0; u < width_; ++u) {
-        const size_t p = row + u;
-        if ((p & 1) == 0 || u == 0) {
-          BoxMuller(CounterHash(key, static_cast<uint32_t>(p >> 1)), &normal[0], &normal[1]);
-        }
-        float signal = 0.0f;
-        const float d = scene.disparity[p];
-        if (d != 0.0f) {
-          const float z = scene.depth[p];
-          const float c = scene.cos_incidence[p];
-          const float diffuse = scene.ir_diffuse[p];
-          const float specular = scene.ir_specular[p];
-          // The pattern reaches the point from the projector unless something is in between
-          // (the IR shadow): its column there is u - d (the projector sits at +b). A Lambertian
-          // surface returns it; a mirror-like one returns glare without the dots.
-          float returned = 0.0f;
-          if (!scene.occluded[p]) {
-            returned = Pattern(static_cast<float>(u) - d, v) * diffuse * c;
-            if (specular > 0.0f) returned += specular * gain * WholePower(c, exponent);
-          }
-          signal = power * returned / (z * z) + ambient * (diffuse + specular);
-        }
-        const float value = signal + std::sqrt(read2 + shot * signal) * normal[p & 1];
-        ir[p] = std::floor(std::clamp(value, 0.0f, 1.0f) * levels + 0.5f) / levels;
-      }
+      const size_t row = static_cast<size_t>(v) * w;
+      DepthNoise(noise, static_cast<uint32_t>(row), w, unused.data(), normal.data());
+      GlareRow(scene.cos_incidence + row, scene.occluded + row, exponent, w, scratch.data(),
+               glare.data());
+      IrRow(p, &pattern_[static_cast<size_t>(v) * samples_], scene.depth + row,
+            scene.disparity + row, scene.cos_incidence + row, scene.occluded + row,
+            scene.ir_diffuse + row, scene.ir_specular + row, glare.data(), normal.data(), w,
+            dots.data(), ir + row);
     }
   });
 }
 
-void SpeckleMatcher::Match(const SpeckleScene& scene, const float* ir, const SpeckleOutput& output,
-                           uint16_t* depth, MissingCause* cause) const {
-  // The rendered disparity of every pixel rounded to an integer (-1: nothing hit), the centre
-  // of each pixel's search.
-  std::vector<int> centre(static_cast<size_t>(width_) * height_);
-  for (size_t p = 0; p < centre.size(); ++p) {
-    const float d = scene.disparity[p];
-    centre[p] = d != 0.0f ? std::min(max_d_ - options_.search_px - 2,
-                                      static_cast<int>(std::lround(d)))
-                          : -1;
+void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
+                           const SpeckleOutput& output, uint16_t* depth, MissingCause* cause) {
+  const size_t pixels = static_cast<size_t>(width_) * height_;
+  centre_.resize(pixels);
+  centre_low_.resize(pixels);
+  blocked_.resize(pixels);
+  Centres(scene.disparity, max_d_ - options_.search_px - 2, pixels, centre_.data(),
+          centre_low_.data());
+  GeometryBlocked(centre_.data(), scene.occluded, pixels, blocked_.data());
+  // Depth units of each raw value on the lattice (0: outside [min_depth, max_depth]).
+  units_by_raw_.assign(2048, 0);  // 2048: raw 2047 means "off the lattice"
+  for (int raw = 0; raw <= 2046; ++raw) {
+    const float z = output.lattice / (output.raw_offset - static_cast<float>(raw));
+    units_by_raw_[raw] =
+        z >= output.min_depth && z <= output.max_depth
+            ? static_cast<int32_t>(std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)))
+            : 0;
   }
-  tbb::parallel_for(tbb::blocked_range<int>(0, height_, 8), [&](const tbb::blocked_range<int>& r) {
-    for (int v = r.begin(); v != r.end(); ++v) MatchRow(scene, ir, output, v, centre, depth, cause);
+  // The IR image as padded 32-bit rows.
+  const int stride = width_ + kBlock;
+  wide_ir_.resize(static_cast<size_t>(height_) * stride);
+  WidenRows(ir, width_, height_, wide_ir_.data());
+  // Rows whose window leaves the image.
+  const int rad = radius_;
+  for (int v = 0; v < height_; ++v) {
+    if (v >= rad && v < height_ - rad) continue;
+    std::fill_n(depth + static_cast<size_t>(v) * width_, width_, uint16_t{0});
+    if (cause != nullptr) {
+      std::fill_n(cause + static_cast<size_t>(v) * width_, width_, MissingCause::kBorder);
+    }
+  }
+  const int bands = (height_ - 2 * rad + kBand - 1) / kBand;
+  // Every band overwrites what it reads of its scratch: which worker's scratch a band gets does
+  // not change its bytes.
+  scratch_.resize(std::max<size_t>(scratch_.size(), tbb::this_task_arena::max_concurrency()));
+  tbb::parallel_for(tbb::blocked_range<int>(0, bands), [&](const tbb::blocked_range<int>& r) {
+    std::unique_ptr<BandScratch>& slot = scratch_[tbb::this_task_arena::current_thread_index()];
+    if (!slot) slot = std::make_unique<BandScratch>(width_);
+    BandScratch& scratch = *slot;
+    for (int b = r.begin(); b != r.end(); ++b) {
+      const int v0 = rad + b * kBand;
+      MatchBand(scene, output, v0, std::min(v0 + kBand, height_ - rad), scratch, depth, cause);
+    }
   });
 }
 
-void SpeckleMatcher::MatchRow(const SpeckleScene& scene, const float* ir,
-                              const SpeckleOutput& output, int v, const std::vector<int>& centre,
-                              uint16_t* depth, MissingCause* cause) const {
+void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
   const int w = width_;
   const int rad = radius_;
-  const int n = options_.window_px * options_.window_px;
+  const int window = options_.window_px;
+  const int n = window * window;
   const size_t row = static_cast<size_t>(v) * w;
-  auto set = [&](int u, uint16_t value, MissingCause why) {
-    depth[row + u] = value;
-    if (cause != nullptr) cause[row + u] = why;
-  };
-  if (v < rad || v >= height_ - rad) {
-    for (int u = 0; u < w; ++u) set(u, 0, MissingCause::kBorder);
-    return;
-  }
-  // Window sums of the IR image and of its squares.
-  std::vector<double> col1(w), col2(w);
-  for (int u = 0; u < w; ++u) {
-    double s1 = 0, s2 = 0;
-    for (int j = -rad; j <= rad; ++j) {
-      const double x = ir[row + static_cast<size_t>(j) * w + u];
-      s1 += x;
-      s2 += x * x;
+  const size_t at = static_cast<size_t>(r) * w;
+  // The IR windows' sums and contrast: low signal where the sum of squared deviations (in full
+  // scale units) is below min_contrast^2 n, i.e. n sq - sum^2 below min_contrast^2 n^2 levels^2.
+  const int stride = w + kBlock;
+  ColumnSums(&wide_ir_[static_cast<size_t>(v - rad) * stride], stride, window, w,
+             s.column_sum.data(), s.column_square.data());
+  BoxSums(s.column_sum.data(), window, w - 2 * rad, s.box_a.data(), s.box_b.data(),
+          &s.sum[at + rad]);
+  BoxSums(s.column_square.data(), window, w - 2 * rad, s.box_a.data(), s.box_b.data(),
+          s.square.data() + rad);
+  const double min_norm2 = options_.min_contrast * options_.min_contrast * n * n *
+                           static_cast<double>(levels_) * levels_;
+  InverseNorms(&s.sum[at + rad], s.square.data() + rad, n, min_norm2, w - 2 * rad,
+               &s.inverse_norm[at + rad]);
+  // Each pixel's search: within search_px of the rendered disparities at the window's centre
+  // and the middles of its sides (a window across a depth edge scores both surfaces).
+  WindowBlocked(&blocked_[row + rad], &s.inverse_norm[at + rad], w - 2 * rad, &s.pre[at + rad]);
+  // (Without edge_candidates the "sides" are the centre itself.)
+  const int side = options_.edge_candidates ? rad : 0;
+  const size_t up = row - static_cast<size_t>(side) * w, down = row + static_cast<size_t>(side) * w;
+  SearchRanges(&centre_low_[row + rad], &centre_low_[up + rad], &centre_low_[down + rad],
+               &centre_[row + rad], &centre_[up + rad], &centre_[down + rad], &s.pre[at + rad],
+               side, options_.search_px, max_d_, w - 2 * rad, &s.first[at + rad],
+               &s.last[at + rad]);
+}
+
+void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& output, int v0,
+                               int v1, BandScratch& s, uint16_t* depth, MissingCause* cause) const {
+  const int w = width_;
+  const int rad = radius_;
+  const int window = options_.window_px;
+  const int n = window * window;
+  const int stride = w + kBlock;
+  for (int v = v0; v < v1; ++v) {
+    const size_t row = static_cast<size_t>(v) * w;
+    std::fill_n(depth + row, rad, uint16_t{0});
+    std::fill_n(depth + row + (w - rad), rad, uint16_t{0});
+    if (cause != nullptr) {
+      std::fill_n(cause + row, rad, MissingCause::kBorder);
+      std::fill_n(cause + row + (w - rad), rad, MissingCause::kBorder);
     }
-    col1[u] = s1;
-    col2[u] = s2;
+    PrepareRow(v, v - v0, s);
   }
-  const int search = options_.search_px;
-  const auto min_correlation = static_cast<float>(options_.min_correlation);
-  const double min_norm2 = options_.min_contrast * options_.min_contrast * n;
-  const auto ambiguity = static_cast<float>(options_.ambiguity_ratio);
-  std::vector<float> column(kSegment + 2 * rad);
-  std::vector<float> cross;
-  std::vector<float> score;
-  for (int u = 0; u < rad; ++u) set(u, 0, MissingCause::kBorder);
-  for (int u = w - rad; u < w; ++u) set(u, 0, MissingCause::kBorder);
-  for (int s = rad; s < w - rad; s += kSegment) {
-    const int e = std::min(s + kSegment, w - rad);  // pixels [s, e)
-    // The integer disparities any window of the segment can need.
+  const auto min_correlation = options_.min_correlation;
+  const auto ambiguity = options_.ambiguity_ratio;
+  for (int start = rad; start < w - rad; start += kSegment) {
+    const int end = std::min(start + kSegment, w - rad);  // pixels [start, end)
+    const int span = end - start;
+    const int length = RoundUp(span + 2 * rad);  // column products per disparity
+    // Every disparity some pixel of the tile needs.
     int lo = std::numeric_limits<int>::max(), hi = -1;
-    for (int j = -rad; j <= rad; ++j) {
-      const int* c = &centre[row + static_cast<size_t>(j) * w];
-      for (int u = s - rad; u < e + rad; ++u) {
-        if (c[u] < 0) continue;
-        lo = std::min(lo, c[u]);
-        hi = std::max(hi, c[u]);
+    for (int r = 0; r < v1 - v0; ++r) {
+      for (int u = start; u < end; ++u) {
+        lo = std::min(lo, s.first[static_cast<size_t>(r) * w + u]);
+        hi = std::max(hi, s.last[static_cast<size_t>(r) * w + u]);
       }
     }
-    if (hi < 0) {
-      for (int u = s; u < e; ++u) set(u, 0, MissingCause::kNothing);
-      continue;
-    }
-    lo = std::max(0, lo - search - 1);
-    hi = std::min(max_d_, hi + search + 1);
-    const int count = hi - lo + 1;
-    const int span = e - s;
-    // cross[(D - lo) * kSegment + (u - s)]: the window sum of ir * reference shifted by D.
-    cross.assign(static_cast<size_t>(count) * kSegment, 0.0f);
-    float* __restrict sums = column.data();
-    for (int d = lo; d <= hi; ++d) {
-      const int width = span + 2 * rad;
-      std::fill_n(sums, width, 0.0f);
-      for (int j = -rad; j <= rad; ++j) {
-        const float* __restrict a = &ir[row + static_cast<size_t>(j) * w + (s - rad)];
-        const float* __restrict b =
-            &reference_[static_cast<size_t>(v + j) * columns_ + (s - rad - d - x_min_)];
-        for (int k = 0; k < width; ++k) sums[k] += a[k] * b[k];
-      }
-      float* __restrict out = &cross[static_cast<size_t>(d - lo) * kSegment];
-      for (int i = 0; i <= 2 * rad; ++i) {
-        for (int k = 0; k < span; ++k) out[k] += sums[k + i];
-      }
-    }
-    for (int u = s; u < e; ++u) {
-      const int c0 = centre[row + u];
-      if (c0 < 0) {
-        set(u, 0, MissingCause::kNothing);
-        continue;
-      }
-      if (scene.occluded[row + u]) {
-        set(u, 0, MissingCause::kShadow);
-        continue;
-      }
-      double s1 = 0, s2 = 0;
-      for (int i = -rad; i <= rad; ++i) {
-        s1 += col1[u + i];
-        s2 += col2[u + i];
-      }
-      const double norm2 = s2 - s1 * s1 / n;
-      if (!(norm2 >= min_norm2) || norm2 <= 0) {
-        set(u, 0, MissingCause::kLowSignal);
-        continue;
-      }
-      const auto inverse_norm = static_cast<float>(1.0 / std::sqrt(norm2));
-      const auto mean = static_cast<float>(s1 / n);
-      // Candidates: within search_px of the rendered disparities at the window's centre and
-      // the middles of its sides.
-      int a = c0, b = c0;
-      for (const size_t q : {row + u - rad, row + u + rad, row + u - static_cast<size_t>(rad) * w,
-                             row + u + static_cast<size_t>(rad) * w}) {
-        if (centre[q] < 0) continue;
-        a = std::min(a, centre[q]);
-        b = std::max(b, centre[q]);
-      }
-      a = std::max(lo, a - search);
-      b = std::min(hi, b + search);
-      score.resize(b - a + 1);
-      int best = -1;
-      for (int d = a; d <= b; ++d) {
-        const size_t at = static_cast<size_t>(v) * columns_ + (u - d - x_min_);
-        const float numerator =
-            cross[static_cast<size_t>(d - lo) * kSegment + (u - s)] - mean * reference_sum_[at];
-        const float zncc = numerator * inverse_norm * reference_inverse_norm_[at];
-        score[d - a] = zncc;
-        if (best < 0 || zncc > score[best - a]) best = d;
-      }
-      const float peak = score[best - a];
-      if (peak < min_correlation || best == a || best == b) {
-        set(u, 0, MissingCause::kNoMatch);
-        continue;
-      }
-      float second = -1.0f;
-      for (int d = a; d <= b; ++d) {
-        if (std::abs(d - best) >= 2) second = std::max(second, score[d - a]);
-      }
-      if (second > ambiguity * peak) {
-        set(u, 0, MissingCause::kAmbiguous);
-        continue;
-      }
-      // Sub-pixel: the vertex of the parabola through the peak and its neighbours.
-      const float left = score[best - 1 - a], right = score[best + 1 - a];
-      const float curvature = left - 2.0f * peak + right;
-      float offset = curvature < 0.0f ? 0.5f * (left - right) / curvature : 0.0f;
-      offset = std::clamp(offset, -0.5f, 0.5f);
-      const float disparity = static_cast<float>(best) + offset;
-      float z;
-      if (output.quantise) {
-        const float raw = std::floor(output.raw_offset - output.subpixel_steps * disparity + 0.5f);
-        if (raw < 0.0f || raw > 2046.0f) {
-          set(u, 0, MissingCause::kRange);
-          continue;
+    const int count = hi >= lo ? hi - lo + 1 : 0;
+    s.products.resize(static_cast<size_t>(count) * length);
+    s.scores.resize(static_cast<size_t>(count) * kSegment);
+    for (int v = v0; v < v1; ++v) {
+      const size_t at = static_cast<size_t>(v - v0) * w;
+      // The window's column products at every disparity: summed down the window for the
+      // tile's first row, then slid down one row at a time (exact integers).
+      for (int d = lo; d <= hi; ++d) {
+        const size_t reference_at = static_cast<size_t>(start - rad - d - x_min_);
+        int32_t* products = &s.products[static_cast<size_t>(d - lo) * length];
+        if (v == v0) {
+          ColumnProducts(&wide_ir_[static_cast<size_t>(v - rad) * stride + (start - rad)], stride,
+                         &reference_[static_cast<size_t>(v - rad) * columns_ + reference_at],
+                         columns_, window, length, products);
+        } else {
+          const size_t in = static_cast<size_t>(v + rad), out = static_cast<size_t>(v - rad - 1);
+          SlideProducts(&wide_ir_[in * stride + (start - rad)],
+                        &reference_[in * columns_ + reference_at],
+                        &wide_ir_[out * stride + (start - rad)],
+                        &reference_[out * columns_ + reference_at], length, products);
         }
-        z = output.lattice / (output.raw_offset - raw);
-      } else {
-        z = output.lattice / (output.subpixel_steps * disparity);
       }
-      if (!(z >= output.min_depth && z <= output.max_depth)) {
-        set(u, 0, MissingCause::kRange);
-        continue;
+      // This row's pixels: their searches' scores, best, second best, verdict.
+      int row_lo = std::numeric_limits<int>::max(), row_hi = -1;
+      for (int u = start; u < end; ++u) {
+        row_lo = std::min(row_lo, s.first[at + u]);
+        row_hi = std::max(row_hi, s.last[at + u]);
       }
-      set(u, static_cast<uint16_t>(std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f))),
-          MissingCause::kValid);
+      const int* first = &s.first[at + start];
+      const int* last = &s.last[at + start];
+      std::fill_n(s.best.begin(), span, -std::numeric_limits<double>::infinity());
+      std::fill_n(s.best_d.begin(), span, -1);
+      std::fill_n(s.second.begin(), span, -1.0);
+      for (int d = row_lo; d <= row_hi; ++d) {
+        BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.box_a.data(),
+                s.box_b.data(), s.cross.data());
+        const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - d - x_min_);
+        double* score = &s.scores[static_cast<size_t>(d - lo) * kSegment];
+        ScoreAndTakeBest(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
+                         &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, d, first,
+                         last, span, d > row_lo ? score - kSegment : s.none.data(), score,
+                         s.best.data(), s.best_d.data(), s.left.data(), s.right.data());
+      }
+      for (int d = row_lo; d <= row_hi; ++d) {
+        TakeSecond(&s.scores[static_cast<size_t>(d - lo) * kSegment], d, first, last,
+                   s.best_d.data(), span, s.second.data());
+      }
+      Decide(s.best.data(), s.best_d.data(), s.second.data(), s.left.data(), s.right.data(), first,
+             last, &s.pre[at + start], min_correlation, ambiguity, span, s.code.data(),
+             s.disparity.data());
+      if (!options_.parabola_subpixel) {
+        // Where the integer match found the pixel's own surface (within a pixel of its
+        // rendered disparity), its rendered disparity; elsewhere (another surface: fattening)
+        // the parabola's.
+        const size_t p = static_cast<size_t>(v) * w + start;
+        for (int k = 0; k < span; ++k) {
+          const float rendered = scene.disparity[p + k];
+          if (std::abs(static_cast<float>(s.best_d[k]) - rendered) < 1.0f) {
+            s.disparity[k] = rendered;
+          }
+        }
+      }
+      Output(output, s.code.data(), s.disparity.data(), span,
+             depth + static_cast<size_t>(v) * w + start,
+             cause != nullptr ? cause + static_cast<size_t>(v) * w + start : nullptr);
     }
+  }
+}
+
+void SpeckleMatcher::Output(const SpeckleOutput& output, const int* code, const float* disparity,
+                            int n, uint16_t* depth, MissingCause* cause) const {
+  int32_t units[kSegment], why[kSegment];
+  if (output.quantise) {
+    LatticeDepth(output, units_by_raw_.data(), code, disparity, n, units, why);
+  } else {
+    for (int k = 0; k < n; ++k) {
+      const float z = output.lattice / (output.subpixel_steps * disparity[k]);
+      const bool valid = code[k] == 0 && z >= output.min_depth && z <= output.max_depth;
+      units[k] = valid ? static_cast<int32_t>(
+                             std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)))
+                       : 0;
+      why[k] = code[k] != 0 ? code[k] : valid ? 0 : static_cast<int>(MissingCause::kRange);
+    }
+  }
+  for (int k = 0; k < n; ++k) depth[k] = static_cast<uint16_t>(units[k]);
+  if (cause != nullptr) {
+    for (int k = 0; k < n; ++k) cause[k] = static_cast<MissingCause>(why[k]);
   }
 }
 

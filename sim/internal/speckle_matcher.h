@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "sim/structured_light.h"
@@ -30,30 +31,42 @@ struct SpeckleOutput {
   float inverse_scale = 0;  // depth units per metre
 };
 
-
 class SpeckleMatcher {
  public:
   // The pattern for a width x height image whose disparities reach max_disparity [px] (larger
   // ones are matched as if at max_disparity and fail).
   SpeckleMatcher(const StructuredLightOptions& options, int width, int height,
                  double max_disparity);
+  ~SpeckleMatcher();
 
-  // The IR image (#width by #height, full scale 1, quantised), its sensor noise keyed by `key`
-  // (counter-based: the same for any thread count).
-  void RenderIr(const SpeckleScene& scene, uint32_t key, float* ir) const;
-  // Depth from the IR image (0 = missing); `cause` (optional, #pixels) says why.
-  void Match(const SpeckleScene& scene, const float* ir, const SpeckleOutput& output,
-             uint16_t* depth, MissingCause* cause = nullptr) const;
+  // The IR image (#width by #height) in ADC counts (0 .. 2^adc_bits - 1), its sensor noise keyed
+  // by `key` (counter-based: the same for any thread count).
+  void RenderIr(const SpeckleScene& scene, uint32_t key, uint16_t* ir) const;
+  // Depth from the IR image (0 = missing); `cause` (optional, #pixels) says why. Not reentrant
+  // (per-frame scratch); the same bytes for any thread count.
+  void Match(const SpeckleScene& scene, const uint16_t* ir, const SpeckleOutput& output,
+             uint16_t* depth, MissingCause* cause = nullptr);
 
-  // The reference pattern at integer column x (>= x_min()) of row v, as matched.
-  float Reference(int x, int v) const;
+  // The reference image at integer column x (>= x_min()) of row v in ADC counts, as matched:
+  // the pattern at whole pixels, scaled so that its brightest sample is full scale.
+  int Reference(int x, int v) const;
   // The pattern at sub-pixel column x of row v, as projected (linear between 1/8 px samples).
   float Pattern(float x, int v) const;
   int x_min() const { return x_min_; }
+  // The integer disparity at which pixel p's search is centred (-1: nothing hit), from the
+  // rendered disparity (as Match computes it).
+  int SearchCentre(float disparity) const;
 
  private:
-  void MatchRow(const SpeckleScene& scene, const float* ir, const SpeckleOutput& output, int v,
-                const std::vector<int>& centre, uint16_t* depth, MissingCause* cause) const;
+  struct BandScratch;
+  // Row v's window statistics and searches into row r of the band's scratch.
+  void PrepareRow(int v, int r, BandScratch& s) const;
+  // Rows [v0, v1) (their windows inside the image).
+  void MatchBand(const SpeckleScene& scene, const SpeckleOutput& output, int v0, int v1,
+                 BandScratch& s, uint16_t* depth, MissingCause* cause) const;
+  // Depth and cause of n pixels from their verdicts and disparities.
+  void Output(const SpeckleOutput& output, const int* code, const float* disparity, int n,
+              uint16_t* depth, MissingCause* cause) const;
 
   StructuredLightOptions options_;
   int width_ = 0, height_ = 0;
@@ -61,14 +74,22 @@ class SpeckleMatcher {
   int x_min_ = 0;        // first integer pattern column (negative: disparities shift left)
   int columns_ = 0;      // integer pattern columns
   int max_d_ = 0;        // largest integer disparity matched
+  int levels_ = 0;       // 2^adc_bits - 1
   static constexpr int kSubsamples = 8;
   int samples_ = 0;      // pattern samples per row: columns_ * kSubsamples + 1
-  std::vector<float> pattern_;    // #height by samples_
-  std::vector<float> reference_;  // #height by columns_
-  // Per row and integer column of the reference: window sum and 1 / norm (norm = sqrt of the
-  // window's sum of squared deviations; 0 where it is 0).
-  std::vector<float> reference_sum_;
-  std::vector<float> reference_inverse_norm_;
+  std::vector<float> pattern_;      // #height by samples_
+  std::vector<int32_t> reference_;  // #height by columns_, ADC counts
+  // Per row and integer column of the reference: the window's sum and 1 / sqrt(n sum of squares -
+  // sum^2) (0 where that is 0), integer sums exact.
+  std::vector<int32_t> reference_sum_;
+  std::vector<double> reference_inverse_norm_;
+  // Per frame and pixel: SearchCentre (-1: nothing hit), the same with a large number for -1,
+  // and why the pixel is not searched (MissingCause: nothing hit, shadow; kValid: it is).
+  std::vector<int> centre_, centre_low_, blocked_;
+  std::vector<int32_t> units_by_raw_;  // per frame: depth units of raw values 0 .. 2047 (0: none)
+  std::vector<int32_t> wide_ir_;        // per frame: the IR image, rows padded to width + 16
+  // Scratch per worker thread (by its index in the task arena), kept from frame to frame.
+  std::vector<std::unique_ptr<BandScratch>> scratch_;
 };
 
 }  // namespace mmh::sim::internal

@@ -6,7 +6,6 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-
 #include <cmath>
 #include <random>
 #include <vector>
@@ -115,6 +114,32 @@ TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   // Small-patch noise against the per-pixel model at 1.5 m (sigma_z 3.5 mm, step 6.5 mm):
   // sqrt(3.5^2 + 6.5^2 / 12) = 4.0 mm, so 3 mm of noise is about 0.75 of it.
   EXPECT_NEAR(white.noise_over_model, 0.75, 0.08);
+  // The plane is turned about 8 deg from the camera: every patch falls in the first bin.
+  EXPECT_EQ(white.noise_over_model_by_incidence[0], white.noise_over_model);
+  EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[1]));
+  EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[2]));
+}
+
+TEST(ErrorStructure, CauseTableCountsEachClassAgainstEachCause) {
+  // One row, 10 pixels: a border run of 2 (the sensor says border), a shadow run of 3 beside a
+  // step down from 2 m to 1 m (the sensor: 2 shadow, 1 no match), valid pixels between.
+  const std::vector<float> depth = {0, 0, 2, 2, 0, 0, 0, 1, 1, 1};
+  const std::vector<MissingClass> classes = ClassifyMissing(depth, 10, 1);
+  ASSERT_EQ(classes[0], MissingClass::kBorder);
+  ASSERT_EQ(classes[4], MissingClass::kShadow);
+  const std::vector<MissingCause> causes = {
+      MissingCause::kBorder, MissingCause::kBorder, MissingCause::kValid,   MissingCause::kValid,
+      MissingCause::kShadow, MissingCause::kShadow, MissingCause::kNoMatch, MissingCause::kValid,
+      MissingCause::kValid,  MissingCause::kValid};
+  const std::string table = FormatCauseTable(classes, causes);
+  // Rows: class; columns: border, nothing hit, shadow, low signal, no match, ambiguous, range.
+  EXPECT_NE(table.find("border             20.00        0.00        0.00        0.00        0.00"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("shadow              0.00        0.00       20.00        0.00       10.00"),
+            std::string::npos)
+      << table;
+  EXPECT_THROW(FormatCauseTable(classes, std::vector<MissingCause>(3)), InputError);
 }
 
 TEST(ErrorStructure, BadInputNamesTheField) {
