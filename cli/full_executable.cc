@@ -44,7 +44,8 @@ void ExecFullExecutable(const std::vector<std::string>& args) {
   argv.push_back(nullptr);
   execv(full.c_str(), argv.data());
   std::cerr << "mmh: failed: cannot start " << full.string() << " (" << std::strerror(errno)
-            << "), which runs every command but compose, stats and sweep; it is built beside "
+            << "), which runs the commands " << self.filename().string()
+            << " does not have; it is built beside "
             << self.filename().string() << " (./mmh build)\n";
   std::exit(1);
 }

@@ -1,8 +1,9 @@
 // The command line is two executables with one command registry (docs/architecture.md,
-// "Start-up"). `mmh` links only the commands that load no heavy library (compose, stats, sweep)
-// and starts in milliseconds; `mmh-full`, built beside it, links every command. `mmh` hands
-// everything else (the other commands, --help, usage errors) to `mmh-full` by exec, with the same
-// arguments, so both print the same help, errors and exit codes.
+// "Start-up"). `mmh` links only the commands that load no heavy library at start (compose,
+// stats, sweep, check-paper, eval, export, report) and starts in milliseconds; `mmh-full`, built
+// beside it, links every command. `mmh` hands everything else (the other commands, --help, usage
+// errors) to `mmh-full` by exec, with the same arguments, so both print the same help, errors and
+// exit codes.
 #pragma once
 
 #include <string>
