@@ -77,6 +77,6 @@ void AddCalibrateCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->callback([args, argv] { RunCalibrate(*args, argv); });
 }
 
-MMH_REGISTER_COMMAND(75, AddCalibrateCommand);
+MMH_REGISTER_COMMAND(77, AddCalibrateCommand);
 
 }  // namespace mmh::cli

@@ -43,6 +43,7 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
                   "one annotation file per take, in the same order");
   }
   const auto threads = LimitThreads(args.common.threads);
+  StartGitCommitLookup();  // for run.json, while the takes are read and composed
 
   // Everything is read and computed before anything is written: bad input leaves no output.
   std::vector<Trajectory> takes;

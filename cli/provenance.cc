@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <functional>
+#include <future>
 #include <memory>
 
 #include "core/library_versions.h"
@@ -34,20 +35,24 @@ std::string Run(const std::string& command) {
   return output;
 }
 
-}  // namespace
-
-std::string GitCommit() {
-  // Asked once per process: `git status` costs ~0.3 s, and a sweep worker runs many cells.
-  static const std::string commit = [] {
+// The answer, asked once per process (a sweep worker runs many cells).
+std::shared_future<std::string>& GitCommitLookup() {
+  static std::shared_future<std::string> commit = std::async(std::launch::async, [] {
     const std::string dir = MMH_SOURCE_DIR;
     const std::string head = Run("git -C '" + dir + "' rev-parse HEAD 2>/dev/null");
     if (head.empty()) return std::string("unknown");
     const std::string dirty =
         Run("git -C '" + dir + "' status --porcelain --untracked-files=no 2>/dev/null");
     return dirty.empty() ? head : head + "-dirty";
-  }();
+  }).share();
   return commit;
 }
+
+}  // namespace
+
+std::string GitCommit() { return GitCommitLookup().get(); }
+
+void StartGitCommitLookup() { GitCommitLookup(); }
 
 std::string ConfigHash(const nlohmann::json& resolved_config) {
   std::uint64_t hash = 1469598103934665603ull;

@@ -33,6 +33,7 @@ void RunStats(const StatsArgs& args, const std::vector<std::string>& argv) {
   for (const auto& set : args.common.sets) config.Set(set);
   config.RequireOnlySections({"stats"});
   const auto options = config.Get<study::StudyAnalysisOptions>("stats");
+  StartGitCommitLookup();  // for run.json, while the data are read and analysed
 
   // Everything is read and computed before anything is written: bad input leaves no output.
   const study::StudyData data = study::ReadStudyData(args.input, options.data);

@@ -13,6 +13,7 @@
 
 #include "cli/command_registry.h"
 #include "cli/compose_command.h"
+#include "cli/full_executable.h"
 #include "core/error.h"
 #include "sweep/aggregate.h"
 #include "sweep/cell_store.h"
@@ -71,7 +72,13 @@ int Aggregate(const fs::path& dir, bool quiet) {
   return a.failed > 0 ? 1 : 0;
 }
 
-void RunSweep(const SweepArgs& args) {
+// The light mmh runs compose sweeps; the cells of other commands, and planning them, need the
+// renderer or the tracker: mmh-full takes over with the same arguments (cli/full_executable.h).
+void RequireCommandHere(sweep::SweepCommand command, const std::vector<std::string>& argv) {
+  if (!HasCommand(sweep::CommandName(command))) ExecFullExecutable(argv);
+}
+
+void RunSweep(const SweepArgs& args, const std::vector<std::string>& argv) {
   if (args.spec.empty() || args.common.out_dir.empty()) {
     throw InputError("mmh sweep needs --spec FILE and --out DIR (or: status DIR, aggregate DIR)");
   }
@@ -79,6 +86,7 @@ void RunSweep(const SweepArgs& args) {
     ThrowBadValue("--backend", "\"" + args.backend + "\"", "local or slurm");
   }
   sweep::SweepSpec spec = sweep::LoadSpec(args.spec);
+  RequireCommandHere(spec.command, argv);
   spec.sets.insert(spec.sets.end(), args.common.sets.begin(), args.common.sets.end());
   const fs::path dir = fs::absolute(args.common.out_dir).lexically_normal();
   const sweep::Plan plan = sweep::BuildPlan(spec, MMH_VERSION, fs::current_path());
@@ -122,9 +130,10 @@ void RunStatus(const SweepArgs& args) {
   std::cout << sweep::StatusReport(plan, dir);
 }
 
-void RunWorker(const SweepArgs& args) {
+void RunWorker(const SweepArgs& args, const std::vector<std::string>& argv) {
   const fs::path dir = fs::absolute(args.dir);
   const sweep::Plan plan = sweep::ReadPlan(dir);
+  RequireCommandHere(plan.spec.command, argv);
   std::vector<int> cells;
   sweep::WorkerOptions options;
   options.threads = args.common.threads > 0 ? args.common.threads : 1;
@@ -185,13 +194,13 @@ void AddSweepCommand(CLI::App& app, const std::vector<std::string>& argv) {
       throw std::runtime_error("some cells failed: see failures.csv");
     }
   });
-  worker->callback([args] { RunWorker(*args); });
-  cmd->callback([args, cmd] {
+  worker->callback([args, argv] { RunWorker(*args, argv); });
+  cmd->callback([args, cmd, argv] {
     if (!cmd->get_subcommands().empty()) return;
-    RunSweep(*args);
+    RunSweep(*args, argv);
   });
 }
 
-MMH_REGISTER_COMMAND(70, AddSweepCommand);
+MMH_REGISTER_COMMAND(75, AddSweepCommand);
 
 }  // namespace mmh::cli

@@ -1,21 +1,18 @@
 #include "core/mesh_io.h"
 
-#include <assimp/material.h>
-#include <assimp/mesh.h>
-#include <assimp/postprocess.h>
-#include <assimp/scene.h>
-
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <system_error>
 #include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/internal/assimp_mesh_import.h"
+#include "core/plugin.h"
 
 namespace mmh {
 namespace {
@@ -29,24 +26,18 @@ std::string LowerExtension(const fs::path& path) {
   return extension;
 }
 
-uint8_t ToByte(float value) {
-  const float clamped = std::clamp(std::isfinite(value) ? value : 0.0f, 0.0f, 1.0f);
-  return static_cast<uint8_t>(std::lround(clamped * 255.0f));
-}
-
-// The diffuse colour of a material, or kDefaultMeshColor for assimp's placeholder material (a file
-// that names no material) or a material without one.
-Rgb8 MaterialColor(const aiScene& scene, unsigned material_index) {
-  if (material_index >= scene.mNumMaterials) return kDefaultMeshColor;
-  const aiMaterial* material = scene.mMaterials[material_index];
-  aiString name;
-  if (material->Get(AI_MATKEY_NAME, name) == aiReturn_SUCCESS &&
-      std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0) {
-    return kDefaultMeshColor;
+// A PLY's header must end with an "end_header" line: assimp 5.2's PLY reader loops for ever on a
+// header without one (a fuzz finding, fuzz/regressions/mesh/ply_without_end_header). Checked in
+// the first MiB, far more than any real header.
+void RequirePlyHeaderEnd(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string start(std::size_t{1} << 20, '\0');
+  in.read(start.data(), static_cast<std::streamsize>(start.size()));
+  start.resize(static_cast<std::size_t>(in.gcount()));
+  if (start.find("\nend_header") == std::string::npos) {
+    ThrowBadValue(path.string(), "a PLY header without an end_header line",
+                  "a valid ply mesh");
   }
-  aiColor4D diffuse;
-  if (material->Get(AI_MATKEY_COLOR_DIFFUSE, diffuse) != aiReturn_SUCCESS) return kDefaultMeshColor;
-  return {ToByte(diffuse.r), ToByte(diffuse.g), ToByte(diffuse.b)};
 }
 
 // Little-endian bytes whatever the host's byte order.
@@ -77,67 +68,31 @@ TriangleMesh LoadMesh(const fs::path& path, double scale) {
                   "an existing OBJ or PLY mesh file");
   }
 
-  Assimp::Importer importer;
-  // Points and lines are dropped: a proxy model is a surface.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const aiScene* scene = importer.ReadFile(
-      path.string(), aiProcess_Triangulate | aiProcess_SortByPType |
-                         aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure);
-  if (scene == nullptr) {
-    ThrowBadValue(where,
-                  "a file assimp cannot read (" + std::string(importer.GetErrorString()) + ")",
+  if (extension == ".ply") RequirePlyHeaderEnd(path);
+
+  // assimp is loaded on the first mesh read (core/internal/assimp_mesh_import.h).
+  static const auto import_mesh = reinterpret_cast<internal::ImportMeshFunction>(
+      PluginSymbol(MMH_ASSIMP_MESH_IMPORT_PLUGIN, internal::kImportMeshSymbol));
+  TriangleMesh mesh;
+  std::string error;
+  if (!import_mesh(path.string(), &mesh, &error)) {
+    ThrowBadValue(where, "a file assimp cannot read (" + error + ")",
                   "a valid " + extension.substr(1) + " mesh");
   }
-
-  TriangleMesh mesh;
-  size_t vertex_total = 0;
-  size_t face_total = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    vertex_total += scene->mMeshes[m]->mNumVertices;
-    face_total += scene->mMeshes[m]->mNumFaces;
-  }
-  mesh.vertices.resize(static_cast<Eigen::Index>(vertex_total), 3);
-  mesh.faces.resize(static_cast<Eigen::Index>(face_total), 3);
-  mesh.face_colors.resize(static_cast<Eigen::Index>(face_total), 3);
-  Eigen::Index v = 0;
-  Eigen::Index f = 0;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh& part = *scene->mMeshes[m];
-    const auto first_vertex = static_cast<uint32_t>(v);
-    for (unsigned i = 0; i < part.mNumVertices; ++i, ++v) {
-      const aiVector3D& p = part.mVertices[i];
-      mesh.vertices.row(v) << static_cast<float>(p.x * scale), static_cast<float>(p.y * scale),
-          static_cast<float>(p.z * scale);
-      if (!mesh.vertices.row(v).allFinite()) {
-        ThrowBadValue(where + ": vertex " + std::to_string(v),
-                      "(" + FormatNumber(p.x) + ", " + FormatNumber(p.y) + ", " +
-                          FormatNumber(p.z) + ") (scaled by " + FormatNumber(scale) + ")",
-                      "finite coordinates");
-      }
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+    const Eigen::RowVector3f file_position = mesh.vertices.row(v);
+    for (int c = 0; c < 3; ++c) {
+      mesh.vertices(v, c) = static_cast<float>(file_position(c) * scale);
     }
-    const Rgb8 material_color = MaterialColor(*scene, part.mMaterialIndex);
-    const aiColor4D* colors = part.mColors[0];
-    for (unsigned i = 0; i < part.mNumFaces; ++i) {
-      const aiFace& face = part.mFaces[i];
-      if (face.mNumIndices != 3) continue;  // SortByPType removed the rest; be safe anyway
-      float sum[3] = {0, 0, 0};
-      for (int k = 0; k < 3; ++k) {
-        mesh.faces(f, k) = first_vertex + face.mIndices[k];
-        if (colors != nullptr) {
-          sum[0] += colors[face.mIndices[k]].r;
-          sum[1] += colors[face.mIndices[k]].g;
-          sum[2] += colors[face.mIndices[k]].b;
-        }
-      }
-      for (int k = 0; k < 3; ++k) {
-        mesh.face_colors(f, k) = colors != nullptr ? ToByte(sum[k] / 3.0f) : material_color[k];
-      }
-      ++f;
+    if (!mesh.vertices.row(v).allFinite()) {
+      ThrowBadValue(where + ": vertex " + std::to_string(v),
+                    "(" + FormatNumber(file_position(0)) + ", " + FormatNumber(file_position(1)) +
+                        ", " + FormatNumber(file_position(2)) + ") (scaled by " +
+                        FormatNumber(scale) + ")",
+                    "finite coordinates");
     }
   }
-  mesh.faces.conservativeResize(f, Eigen::NoChange);
-  mesh.face_colors.conservativeResize(f, Eigen::NoChange);
+  const Eigen::Index f = mesh.faces.rows();
   if (f == 0) ThrowBadValue(where, "a file without triangles", "a mesh with at least one triangle");
   ValidateMesh(mesh, where);
   return mesh;

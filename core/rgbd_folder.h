@@ -13,8 +13,8 @@
 // The reader also opens public TUM RGB-D sequences (no camera.json): the intrinsics then come from
 // an explicit argument or from 'freiburg1/2/3' in the folder name.
 //
-// StagedFolder is the all-or-nothing rule every mmh output folder follows (also the fakenect dump
-// of sim/fakenect_writer.h).
+// The writer stages its folder (core/staged_folder.h, the all-or-nothing rule of every mmh output
+// folder).
 #pragma once
 
 #include <filesystem>
@@ -28,6 +28,7 @@
 #include "core/image_io.h"
 #include "core/rgbd_frame.h"
 #include "core/rigid3.h"
+#include "core/staged_folder.h"
 #include "core/trajectory.h"
 
 namespace mmh {
@@ -56,37 +57,6 @@ struct RgbdCameraInfo {
 // selects fr1 517.3/516.5/318.6/255.3, fr2 520.9/521.0/325.1/249.7, fr3 535.4/539.2/320.1/247.6
 // (640x480, depth registered to colour, 5000 units = 1 m); nullopt for other names.
 std::optional<RgbdCameraInfo> TumCameraInfoFromName(const std::string& folder_name);
-
-// An output folder written whole: files go into a staging folder beside the target
-// ('<target>.partial-<pid>'); Commit() moves it into place, so readers never see a half-written
-// folder, and destruction without Commit() removes the staging folder.
-//
-// An existing target is replaced only when it is empty or was written by mmh (it holds a marker
-// file, camera.json, fakenect.json or run.json, whose "writer" is "mmh"); anything else is an
-// InputError naming it, checked when the StagedFolder is made and again in Commit().
-class StagedFolder {
- public:
-  explicit StagedFolder(const std::filesystem::path& target);
-  ~StagedFolder();
-  StagedFolder(const StagedFolder&) = delete;
-  StagedFolder& operator=(const StagedFolder&) = delete;
-
-  // Moves the staging folder to the target (an old mmh folder there is removed).
-  void Commit();
-
-  const std::filesystem::path& target() const { return target_; }
-  const std::filesystem::path& staging() const { return staging_; }
-  bool committed() const { return committed_; }
-
- private:
-  std::filesystem::path target_;
-  std::filesystem::path staging_;
-  bool committed_ = false;
-};
-
-// The marker files by which an output folder is recognised as mmh's (their "writer" is "mmh").
-inline constexpr const char* kMmhMarkerFiles[] = {"camera.json", "fakenect.json", "run.json"};
-inline constexpr const char* kMmhWriterName = "mmh";
 
 // Writes one sequence through a StagedFolder: Finish() moves it into place, a writer destroyed
 // without Finish() leaves nothing. An existing target is replaced only when it is empty or mmh

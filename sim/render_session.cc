@@ -186,12 +186,6 @@ nlohmann::json RenderConfig::ToJson() const {
   return j;
 }
 
-TriangleMesh LoadProxyModel(const std::string& proxy, double scale) {
-  if (proxy.empty()) return BuildDuploMesh(SoldierProxy());
-  if (EndsWith(proxy, ".json")) return BuildDuploMesh(LoadDuploAssembly(proxy));
-  return LoadMesh(proxy, scale);
-}
-
 TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model)
     : config_(config), table_T_camera_(config.camera.TableTCamera()) {
   for (const NamedMesh& part : BuildTableScene(config.scene)) {

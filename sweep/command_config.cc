@@ -1,14 +1,13 @@
 #include "sweep/command_config.h"
 
 #include <filesystem>
+#include <map>
+#include <stdexcept>
 
 #include "core/config.h"
 #include "core/error.h"
 #include "core/options.h"
 #include "montage/compose.h"
-#include "pipeline/animator_run.h"
-#include "study/simulated_study.h"
-#include "track/track_session.h"
 
 namespace mmh::sweep {
 namespace {
@@ -36,26 +35,30 @@ std::vector<InputSpec> InputsOf(SweepCommand command) {
   return {};
 }
 
+std::map<SweepCommand, ConfigResolver>& Resolvers() {
+  static std::map<SweepCommand, ConfigResolver> resolvers;
+  return resolvers;
+}
+
 }  // namespace
 
+bool RegisterConfigResolver(SweepCommand command, ConfigResolver resolver) {
+  Resolvers()[command] = resolver;
+  return true;
+}
+
 nlohmann::json ResolveCommandConfig(SweepCommand command, const Config& config) {
-  switch (command) {
-    case SweepCommand::kCompose: {
-      // As `mmh compose` reads it (cli/compose_command.cc).
-      config.RequireOnlySections({"montage"});
-      return {{"montage", ToJson(config.Get<montage::ComposeOptions>("montage"))}};
-    }
-    case SweepCommand::kRun:
-      return pipeline::RunConfig::FromConfig(config).ToJson();
-    case SweepCommand::kStudy: {
-      const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
-      study_config.study.Validate("study");
-      return study_config.ToJson();
-    }
-    case SweepCommand::kTrack:
-      return track::TrackConfig::FromConfig(config).ToJson();
+  if (command == SweepCommand::kCompose) {
+    // As `mmh compose` reads it (cli/compose_command.cc).
+    config.RequireOnlySections({"montage"});
+    return {{"montage", ToJson(config.Get<montage::ComposeOptions>("montage"))}};
   }
-  return {};
+  const auto it = Resolvers().find(command);
+  if (it == Resolvers().end()) {
+    throw std::logic_error(std::string("no config resolver for `mmh ") + CommandName(command) +
+                           "` in this program (link mmh::sweep_resolvers)");
+  }
+  return it->second(config);
 }
 
 std::vector<std::string> CommandInputs(const SweepSpec& spec) {

@@ -1,0 +1,109 @@
+// The two executables (cli/full_executable.h, docs/architecture.md "Start-up"): the light `mmh`
+// loads none of the heavy libraries, and hands every other command to `mmh-full` with the same
+// help, errors and exit codes.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "tests/test_util.h"
+
+namespace mmh {
+namespace {
+
+namespace fs = std::filesystem;
+using test_util::RunMmh;
+
+const fs::path kFull = fs::path(MMH_BINARY).parent_path() / "mmh-full";
+
+// Runs a shell command; stdout and stderr.
+test_util::CommandResult Shell(const std::string& command) {
+  test_util::CommandResult result;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  char buffer[512];
+  while (fgets(buffer, sizeof(buffer), pipe)) result.output += buffer;
+  result.exit_code = WEXITSTATUS(pclose(pipe));
+  return result;
+}
+
+// The shared objects the dynamic loader maps for `binary` (its ldd mode), one per line.
+std::string LoadedLibraries(const fs::path& binary) {
+  return Shell("LD_TRACE_LOADED_OBJECTS=1 " + binary.string()).output;
+}
+
+// `output` with every mention of mmh-full's path replaced by mmh's, as if mmh had printed it.
+std::string AsMmh(std::string output) {
+  for (std::size_t at; (at = output.find(kFull.string())) != std::string::npos;) {
+    output.replace(at, kFull.string().size(), MMH_BINARY);
+  }
+  return output;
+}
+
+TEST(StartupTest, LightExecutableLoadsNoHeavyLibrary) {
+  const std::string light = LoadedLibraries(MMH_BINARY);
+  const std::string full = LoadedLibraries(kFull);
+  // The check itself sees them: mmh-full loads the tracker's and the renderer's.
+  for (const char* heavy : {"libpcl_", "libopencv_", "libembree"}) {
+    EXPECT_EQ(light.find(heavy), std::string::npos) << heavy << " in:\n" << light;
+    EXPECT_NE(full.find(heavy), std::string::npos) << heavy << " not in mmh-full";
+  }
+  // OpenImageIO and assimp are plugins of both, loaded when an image or a mesh is read.
+  for (const char* plugin_library : {"libOpenImageIO", "libassimp"}) {
+    EXPECT_EQ(light.find(plugin_library), std::string::npos) << light;
+    EXPECT_EQ(full.find(plugin_library), std::string::npos) << full;
+  }
+  int lines = 0;
+  for (char c : light) lines += c == '\n';
+  EXPECT_LE(lines, 8) << light;  // vdso, loader, libc, libm, libgcc_s, libstdc++, TBB
+  const auto version = RunMmh("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_EQ(version.output, Shell(kFull.string() + " --version").output);
+  EXPECT_FALSE(version.output.empty());
+}
+
+TEST(StartupTest, OtherCommandsRunInMmhFullWithTheSameHelpErrorsAndExitCodes) {
+  // mmh-full starts in 0.2-1 s: few cases.
+  for (const std::string args : {"--help", "run --help", "", "bogus", "study --bogus",
+                                 "compose --help"}) {
+    const auto via_mmh = RunMmh(args);
+    const auto full = Shell(kFull.string() + " " + args);
+    EXPECT_EQ(via_mmh.exit_code, full.exit_code) << args;
+    EXPECT_EQ(via_mmh.output, AsMmh(full.output)) << args;
+  }
+  const auto help = RunMmh("--help");
+  EXPECT_NE(help.output.find("render"), std::string::npos) << help.output;
+  EXPECT_NE(help.output.find("sweep"), std::string::npos) << help.output;
+  EXPECT_EQ(RunMmh("bogus").exit_code, 2);
+}
+
+TEST(StartupTest, SweepsOfHeavyCommandsArePlannedByMmhFull) {
+  test_util::TempDir dir;
+  const auto r = RunMmh("sweep --spec " + std::string(MMH_SOURCE_DIR) +
+                        "/configs/sweeps/study_power.json --out " + (dir.path() / "s").string() +
+                        " --dry-run --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string plan = test_util::ReadBytes(dir.path() / "s" / "plan.json");
+  EXPECT_NE(plan.find("\"study\""), std::string::npos);
+  const auto status = RunMmh("sweep status " + (dir.path() / "s").string());
+  EXPECT_EQ(status.exit_code, 0) << status.output;
+  EXPECT_NE(status.output.find("15 cells"), std::string::npos) << status.output;
+}
+
+TEST(StartupTest, WithoutMmhFullTheLightCommandsStillRunAndTheOthersFailClearly) {
+  test_util::TempDir dir;
+  const fs::path alone = dir.path() / "mmh";
+  fs::copy_file(MMH_BINARY, alone);
+  const auto version = Shell(alone.string() + " --version");
+  EXPECT_EQ(version.exit_code, 0) << version.output;
+  const auto help = Shell(alone.string() + " compose --help");
+  EXPECT_EQ(help.exit_code, 0) << help.output;
+  const auto render = Shell(alone.string() + " render --help");
+  EXPECT_EQ(render.exit_code, 1);
+  EXPECT_NE(render.output.find("cannot start " + (dir.path() / "mmh-full").string()),
+            std::string::npos)
+      << render.output;
+}
+
+}  // namespace
+}  // namespace mmh
