@@ -18,6 +18,8 @@ using test_util::RunMmh;
 class CalibrateCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    // The study config's story paths are relative to the project (as when run from it).
+    fs::current_path(MMH_SOURCE_DIR);
     // Four cells of one parameter, 2 studies of 5 animators each (about 0.2 s of CPU a study).
     json spec = {
         {"command", "study"},

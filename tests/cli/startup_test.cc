@@ -78,6 +78,8 @@ TEST(StartupTest, OtherCommandsRunInMmhFullWithTheSameHelpErrorsAndExitCodes) {
 }
 
 TEST(StartupTest, SweepsOfHeavyCommandsArePlannedByMmhFull) {
+  // The spec's paths are relative to the project (as when run from it).
+  fs::current_path(MMH_SOURCE_DIR);
   test_util::TempDir dir;
   const auto r = RunMmh("sweep --spec " + std::string(MMH_SOURCE_DIR) +
                         "/configs/sweeps/study_power.json --out " + (dir.path() / "s").string() +

@@ -21,8 +21,9 @@ TEST(SelfAppraisalTest, BiasIsProgressPlusChoice) {
   EXPECT_DOUBLE_EQ(SelfAppraisalBias(o, 3, 3), 0.25);
   // One take: it is the last one.
   EXPECT_DOUBLE_EQ(SelfAppraisalBias(o, 0, 1), 0.2);
-  // The defaults are the unbiased viewer.
-  for (int item = 0; item <= 3; ++item) EXPECT_EQ(SelfAppraisalBias({}, item, 3), 0.0);
+  // Zero weights are the unbiased viewer (the hand-set people before the calibration).
+  const SelfAppraisalOptions unbiased{.progress_weight = 0, .choice_bonus = 0};
+  for (int item = 0; item <= 3; ++item) EXPECT_EQ(SelfAppraisalBias(unbiased, item, 3), 0.0);
 }
 
 TEST(SelfAppraisalTest, BadValuesAreErrors) {

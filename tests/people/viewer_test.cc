@@ -67,9 +67,11 @@ TEST(ViewerTest, ViewersPreferTheBetterAnimation) {
     prefer_good +=
         Utility(good, viewer, options, 7, 2 * v) > Utility(fair, viewer, options, 7, 2 * v + 1);
   }
-  // P(prefer) = Φ(0.05·b_q / (√2·0.05)) ≈ 0.76 for b_q ≈ 1.
-  EXPECT_GT(prefer_good, 130);
-  EXPECT_LT(prefer_good, 185);
+  // P(prefer) = Φ(0.05·b_q / (√2·σ)) for b_q ≈ 1 (0.56 at the calibrated σ = 0.236): within 4
+  // binomial standard deviations of 200 viewings.
+  const double p = 0.5 * std::erfc(-0.05 / (std::sqrt(2.0) * options.judgement_noise) / std::sqrt(2.0));
+  EXPECT_NEAR(prefer_good, 200 * p, 4 * std::sqrt(200 * p * (1 - p)));
+  EXPECT_GT(prefer_good, 100);  // the better animation is preferred more often than not
   // Reproducible per (seed, index) and (seed, viewing).
   EXPECT_EQ(DrawViewer(options, 7, 3).quality_weight, DrawViewer(options, 7, 3).quality_weight);
   const Viewer viewer = DrawViewer(options, 7, 3);

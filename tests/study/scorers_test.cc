@@ -111,6 +111,7 @@ TEST(ScorersTest, ViewersPreferTheBetterAnimation) {
   const ScorerOptions options;
   const ScoringDesign design = DrawScoringDesign(options, 20, 3, 11);
   sim::ViewerOptions viewer;
+  viewer.judgement_noise = 0.05;  // the hand-set σ: differences of 0.3 always decide
   // Montage clearly better (0.3 quality above the takes; noise sd 0.05): it wins every time.
   std::vector<AnimationAppeals> better(20);
   for (auto& a : better) {
@@ -139,13 +140,22 @@ TEST(ScorersTest, ViewersPreferTheBetterAnimation) {
   EXPECT_TRUE(scorers.count("A01") && scorers.count("A20") && scorers.count("S22"));
 }
 
+sim::ViewerOptions PreciseViewer() {
+  sim::ViewerOptions viewer;
+  viewer.judgement_noise = 0.05;
+  return viewer;
+}
+
+sim::SelfAppraisalOptions Unbiased() { return {.progress_weight = 0, .choice_bonus = 0}; }
+
 TEST(ScorersTest, RankingsArePermutationsFollowingUtility) {
   std::vector<AnimationAppeals> appeals(5);
   for (auto& a : appeals) {
     a.takes = {AppealOf(0.2), AppealOf(0.5), AppealOf(0.8)};
     a.montage = AppealOf(0.95);
   }
-  const auto rows = RankOwnAnimations(appeals, sim::ViewerOptions{}, {}, 1);
+  // Viewing noise far below the differences, no self-appraisal: the utilities decide.
+  const auto rows = RankOwnAnimations(appeals, PreciseViewer(), Unbiased(), 1);
   ASSERT_EQ(rows.size(), 20u);
   StudyData data;
   data.rankings = rows;
@@ -169,7 +179,7 @@ TEST(ScorersTest, SelfAppraisalBiasesTheAnimatorsOnly) {
   sim::SelfAppraisalOptions biased;
   biased.progress_weight = 1.0;  // far larger than the differences: recording order decides
   biased.choice_bonus = 0.5;
-  for (const auto& row : RankOwnAnimations(appeals, sim::ViewerOptions{}, biased, 1)) {
+  for (const auto& row : RankOwnAnimations(appeals, PreciseViewer(), biased, 1)) {
     const double expected = row.item == "montage" ? 1
                             : row.item == "take3" ? 2
                             : row.item == "take2" ? 3
@@ -178,7 +188,7 @@ TEST(ScorersTest, SelfAppraisalBiasesTheAnimatorsOnly) {
   }
   // Without the biases take 1 ranks first for most animators.
   int take1_first = 0;
-  for (const auto& row : RankOwnAnimations(appeals, sim::ViewerOptions{}, {}, 1)) {
+  for (const auto& row : RankOwnAnimations(appeals, PreciseViewer(), Unbiased(), 1)) {
     take1_first += row.item == "take1" && row.rank == 1;
   }
   EXPECT_GE(take1_first, 15);
