@@ -3,9 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "core/error.h"
+#include "stats/descriptive.h"
 
 namespace mmh::calibrate {
 
@@ -42,16 +42,11 @@ AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
     // A statistic that barely varies (e.g. a count at its bound) gets its sd instead; a constant
     // one cannot discriminate and weighs nothing.
     if (!(mad > 0)) {
-      double mean = 0, sq = 0;
-      int m = 0;
+      std::vector<double> present;
       for (const Simulation& s : simulations) {
-        if (s.values[k]) mean += *s.values[k], ++m;
+        if (s.values[k]) present.push_back(*s.values[k]);
       }
-      mean = m ? mean / m : 0;
-      for (const Simulation& s : simulations) {
-        if (s.values[k]) sq += (*s.values[k] - mean) * (*s.values[k] - mean);
-      }
-      mad = m > 1 ? std::sqrt(sq / (m - 1)) : 0;
+      mad = present.size() > 1 ? std::sqrt(stats::Variance(present)) : 0;
     }
     result.scales.push_back(mad);
   }
@@ -128,10 +123,8 @@ AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
     p.median = Quantile(values, 0.5);
     p.q05 = Quantile(values, 0.05);
     p.q95 = Quantile(values, 0.95);
-    p.mean = std::accumulate(values.begin(), values.end(), 0.0) / values.size();
-    double sq = 0;
-    for (double v : values) sq += (v - p.mean) * (v - p.mean);
-    p.sd = values.size() > 1 ? std::sqrt(sq / (values.size() - 1)) : 0;
+    p.mean = stats::Mean(values);
+    p.sd = values.size() > 1 ? std::sqrt(stats::Variance(values)) : 0;
     result.posterior.push_back(p);
   }
   return result;

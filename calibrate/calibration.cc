@@ -177,21 +177,15 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
   }
 
   // The calibrated config: the estimate, rounded, as config sections.
-  nlohmann::json calibrated = nlohmann::json::object();
+  Config calibrated;
   Config config = Config::Load(sweep::CellConfigPath(sweep_dir, plan.cells.front()));
   for (std::size_t j = 0; j < result.parameters.size(); ++j) {
-    const std::string value = Rounded(result.estimate[j], options.digits);
-    config.Set(result.parameters[j].key + "=" + value);
-    nlohmann::json* node = &calibrated;
-    const std::string& key = result.parameters[j].key;
-    std::size_t start = 0;
-    for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.', start)) {
-      node = &(*node)[key.substr(start, dot - start)];
-      start = dot + 1;
-    }
-    (*node)[key.substr(start)] = std::stod(value);
+    const std::string assignment =
+        result.parameters[j].key + "=" + Rounded(result.estimate[j], options.digits);
+    calibrated.Set(assignment);
+    config.Set(assignment);
   }
-  result.calibrated_config = calibrated;
+  result.calibrated_config = calibrated.root();
 
   // Posterior predictive check: new people and scorers at the estimate.
   config.Set("population.seed=" + std::to_string(options.ppc_seed));

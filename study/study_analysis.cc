@@ -183,29 +183,29 @@ nlohmann::json StudySummary::ToJson() const {
           {"warnings", warnings}};
 }
 
+namespace {
+nlohmann::json OptionalJson(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+}  // namespace
+
 nlohmann::json SegmentConstraintAnalysis::ToJson() const {
   nlohmann::json per = nlohmann::json::array();
   for (const auto& a : animators) {
-    auto opt = [](const std::optional<double>& v) {
-      return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-    };
     per.push_back({{"animator", a.animator},
                    {"increase", a.increase},
                    {"increase_percent", a.increase_percent},
-                   {"paper_scale_percent", opt(a.paper_scale_percent)},
-                   {"increase_per_frame", opt(a.increase_per_frame)},
+                   {"paper_scale_percent", OptionalJson(a.paper_scale_percent)},
+                   {"increase_per_frame", OptionalJson(a.increase_per_frame)},
                    {"short_segments_unconstrained", a.short_segments_unconstrained}});
   }
-  auto opt = [](const std::optional<double>& v) {
-    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-  };
   return {{"animators", per},
           {"animators_with_short_segments", animators_with_short_segments},
           {"max_increase_percent", max_increase_percent},
           {"mean_increase_percent", mean_increase_percent},
-          {"max_paper_scale_percent", opt(max_paper_scale_percent)},
-          {"mean_paper_scale_percent", opt(mean_paper_scale_percent)},
-          {"max_increase_per_frame", opt(max_increase_per_frame)},
+          {"max_paper_scale_percent", OptionalJson(max_paper_scale_percent)},
+          {"mean_paper_scale_percent", OptionalJson(mean_paper_scale_percent)},
+          {"max_increase_per_frame", OptionalJson(max_increase_per_frame)},
           {"all_below_threshold", all_below_threshold},
           {"threshold_scale", threshold_scale}};
 }
