@@ -14,6 +14,7 @@
 #include <future>
 #include <memory>
 
+#include "core/config_hash.h"
 #include "core/library_versions.h"
 #include "sim/library_versions.h"
 #include "track/library_versions.h"
@@ -53,17 +54,6 @@ std::shared_future<std::string>& GitCommitLookup() {
 std::string GitCommit() { return GitCommitLookup().get(); }
 
 void StartGitCommitLookup() { GitCommitLookup(); }
-
-std::string ConfigHash(const nlohmann::json& resolved_config) {
-  std::uint64_t hash = 1469598103934665603ull;
-  for (unsigned char c : resolved_config.dump()) {
-    hash ^= c;
-    hash *= 1099511628211ull;
-  }
-  char text[17];
-  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
-  return text;
-}
 
 nlohmann::json Provenance(const std::vector<std::string>& argv,
                           const nlohmann::json& resolved_config, int threads,

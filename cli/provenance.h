@@ -15,10 +15,7 @@ std::string GitCommit();
 // it once their input is checked, before their work, which hides git's time behind it.
 void StartGitCommitLookup();
 
-// FNV-1a 64-bit hash of the resolved config's canonical dump, as 16 hex digits.
-std::string ConfigHash(const nlohmann::json& resolved_config);
-
-// run.json: command line, commit, config hash, library versions, host, threads, timings.
+// run.json: command line, commit, config hash (core/config_hash.h), library versions, host, threads, timings.
 nlohmann::json Provenance(const std::vector<std::string>& argv,
                           const nlohmann::json& resolved_config, int threads,
                           const nlohmann::json& timings);

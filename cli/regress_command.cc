@@ -28,31 +28,6 @@ struct RegressArgs {
   bool update = false;
 };
 
-// The config keys that name files.
-constexpr const char* kPathKeys[][2] = {{"render", "story"},
-                                        {"run", "practice"},
-                                        {"render", "proxy"},
-                                        {"render", "trajectory"},
-                                        {"render", "annotation"}};
-
-// Relative file paths of a scenario's config resolve against the baseline's root, so that
-// `mmh regress` gives the same runs from any working directory. Returns the config's JSON with
-// the paths as written (for the config hash, which must not depend on where the clone is).
-nlohmann::json ResolvePaths(Config& config, const std::filesystem::path& root) {
-  const nlohmann::json as_written = config.root();
-  for (const auto& [section, key] : kPathKeys) {
-    const auto s = config.root().find(section);
-    if (s == config.root().end() || !s->is_object()) continue;
-    const auto v = s->find(key);
-    if (v == s->end() || !v->is_string()) continue;
-    const std::string path = v->get<std::string>();
-    if (path.empty() || std::filesystem::path(path).is_absolute()) continue;
-    config.Set(std::string(section) + "." + key + "=" +
-               nlohmann::json((root / path).lexically_normal().string()).dump());
-  }
-  return as_written;
-}
-
 void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
   const pipeline::Baseline baseline = pipeline::ReadBaseline(args.baseline);
   for (const std::string& name : args.scenarios) {
@@ -66,70 +41,37 @@ void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
     }
   }
   // Every scenario's config is read and checked before anything runs.
-  struct Prepared {
-    const pipeline::Scenario* scenario;
-    pipeline::RunConfig config;
-    std::string hash;
-  };
-  std::vector<Prepared> runs;
+  std::vector<pipeline::PreparedScenario> runs;
   for (const pipeline::Scenario& scenario : baseline.scenarios) {
-    if (!args.scenarios.empty() && std::find(args.scenarios.begin(), args.scenarios.end(),
-                                             scenario.name) == args.scenarios.end()) {
-      continue;
+    if (args.scenarios.empty() || std::find(args.scenarios.begin(), args.scenarios.end(),
+                                            scenario.name) != args.scenarios.end()) {
+      runs.push_back(pipeline::PrepareScenario(baseline, scenario));
     }
-    Config config = Config::Load(scenario.config);
-    for (const std::string& set : scenario.sets) config.Set(set);
-    const nlohmann::json as_written = ResolvePaths(config, baseline.root);
-    pipeline::RunConfig run_config = pipeline::RunConfig::FromConfig(config);
-    // The hash of the resolved config with the paths as the scenario writes them.
-    nlohmann::json resolved = run_config.ToJson();
-    for (const auto& [section, key] : kPathKeys) {
-      if (as_written.contains(section) && as_written[section].contains(key)) {
-        resolved[section][key] = as_written[section][key];
-      }
-    }
-    const std::string hash = ConfigHash(resolved);
-    runs.push_back({&scenario, std::move(run_config), hash});
   }
   const auto threads = LimitThreads(args.common.threads);
   const std::filesystem::path out = args.common.out_dir;
   EnsureDirectory(out);
   const bool bar = ShowProgress(args.common);
   std::vector<pipeline::MetricComparison> comparisons;
-  nlohmann::json updated = nlohmann::json::array();
+  std::vector<pipeline::Scenario> updated;
   nlohmann::json report = nlohmann::json::array();
-  for (const Prepared& p : runs) {
+  for (const pipeline::PreparedScenario& p : runs) {
     if (!args.common.quiet && !p.scenario->config_hash.empty() &&
-        p.scenario->config_hash != p.hash) {
+        p.scenario->config_hash != p.config_hash) {
       std::cerr << "regress: " << p.scenario->name << ": the resolved config differs from the "
-                << "baseline's (hash " << p.hash << ", baseline " << p.scenario->config_hash
+                << "baseline's (hash " << p.config_hash << ", baseline " << p.scenario->config_hash
                 << "): a default changed; differences may come from that\n";
     }
     const pipeline::AnimatorRun run =
         RunScenario(p.config, p.config.render.render.animator, out / p.scenario->name, bar, argv,
                     args.common.threads);
-    const auto c = pipeline::CompareWithBaseline(*p.scenario, run.metrics);
+    const nlohmann::json metrics = pipeline::ToJson(*run.metrics);
+    const auto c = pipeline::CompareWithBaseline(*p.scenario, metrics);
     comparisons.insert(comparisons.end(), c.begin(), c.end());
     report.push_back({{"scenario", p.scenario->name},
-                      {"config_hash", p.hash},
+                      {"config_hash", p.config_hash},
                       {"seconds", pipeline::SecondsToJson(run)}});
-    if (args.update) {
-      pipeline::Scenario next = *p.scenario;
-      next.config_hash = p.hash;
-      // Keep the tolerances a researcher set; new metrics get the defaults.
-      auto defaults = pipeline::DefaultBaselineMetrics(run.metrics);
-      for (auto& [key, t] : defaults) {
-        for (const auto& [old_key, old] : p.scenario->metrics) {
-          if (old_key == key) {
-            t.tolerance = old.tolerance, t.relative = old.relative, t.better = old.better;
-          }
-        }
-      }
-      next.metrics = defaults;
-      nlohmann::json j = pipeline::ToJson(next);
-      j["config"] = std::filesystem::relative(p.scenario->config, baseline.root).string();
-      updated.push_back(j);
-    }
+    if (args.update) updated.push_back(pipeline::UpdatedScenario(*p.scenario, metrics, p.config_hash));
   }
   WriteFileAtomically(out / "regress.csv", pipeline::ComparisonsToCsv(comparisons));
   const int regressed = static_cast<int>(std::count_if(
@@ -150,23 +92,7 @@ void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
   WriteFileAtomically(out / "run.json",
                       Provenance(argv, summary, args.common.threads, {}).dump(2) + "\n");
   if (args.update) {
-    // Scenarios not run this time are kept as they were.
-    nlohmann::json scenarios = nlohmann::json::array();
-    for (const pipeline::Scenario& s : baseline.scenarios) {
-      bool replaced = false;
-      for (const nlohmann::json& u : updated) {
-        if (u["name"] == s.name) scenarios.push_back(u), replaced = true;
-      }
-      if (!replaced) {
-        nlohmann::json j = pipeline::ToJson(s);
-        j["config"] = std::filesystem::relative(s.config, baseline.root).string();
-        scenarios.push_back(j);
-      }
-    }
-    std::ifstream in(baseline.file);
-    nlohmann::json file = nlohmann::json::parse(in);
-    file["scenarios"] = scenarios;
-    WriteFileAtomically(baseline.file, file.dump(2) + "\n");
+    pipeline::WriteBaseline(baseline, updated);
     if (!args.common.quiet)
       std::cout << "regress: baseline updated: " << baseline.file.string() << "\n";
     return;

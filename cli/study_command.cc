@@ -13,6 +13,7 @@
 #include "cli/command_registry.h"
 #include "cli/common_flags.h"
 #include "cli/provenance.h"
+#include "pipeline/run_metrics.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
@@ -78,7 +79,7 @@ nlohmann::json AnimatorJson(const study::AnimatorOutcome& a) {
                                        ? nlohmann::json(a.truth_montage_appeal->appeal)
                                        : nlohmann::json(nullptr)},
           {"rendered_frames", a.rendered_frames},
-          {"metrics", a.metrics}};
+          {"metrics", a.metrics ? pipeline::ToJson(*a.metrics) : nlohmann::json(nullptr)}};
 }
 
 void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {

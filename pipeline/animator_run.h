@@ -25,6 +25,7 @@
 #include "metrics/tracking_metrics.h"
 #include "montage/compose.h"
 #include "pipeline/error_model.h"
+#include "pipeline/run_metrics.h"
 #include "people/annotator.h"
 #include "people/performance.h"
 #include "people/population.h"
@@ -130,7 +131,7 @@ struct AnimatorRun {
   // (sim::CompositeQuality).
   std::vector<double> montage_quality;
   std::vector<double> truth_montage_quality;
-  nlohmann::json metrics;  // metrics.json (see pipeline/run_metrics.h); null unless run.metrics
+  std::optional<RunMetrics> metrics;  // metrics.json; only with run.metrics
   StageSeconds seconds;
   int rendered_frames = 0;  // frames rendered and tracked or read (0 in fast fidelity)
 };

@@ -7,7 +7,12 @@
 #include <map>
 #include <sstream>
 
+#include "core/atomic_file.h"
+#include "core/config.h"
+#include "core/config_hash.h"
 #include "core/error.h"
+#include "core/json_text.h"
+#include "core/text_parsing.h"
 #include "core/options.h"
 #include "pipeline/run_metrics.h"
 
@@ -243,6 +248,70 @@ std::string ComparisonsToCsv(const std::vector<MetricComparison>& comparisons) {
         << ',' << BetterName(c.baseline.better) << ',' << VerdictName(c.verdict) << '\n';
   }
   return out.str();
+}
+
+namespace {
+
+// The config keys that name files.
+constexpr const char* kPathKeys[][2] = {{"render", "story"},
+                                        {"run", "practice"},
+                                        {"render", "proxy"},
+                                        {"render", "trajectory"},
+                                        {"render", "annotation"}};
+
+}  // namespace
+
+PreparedScenario PrepareScenario(const Baseline& baseline, const Scenario& scenario) {
+  Config config = Config::Load(scenario.config);
+  for (const std::string& set : scenario.sets) config.Set(set);
+  const nlohmann::json as_written = config.root();
+  for (const auto& [section, key] : kPathKeys) {
+    const auto s = config.root().find(section);
+    if (s == config.root().end() || !s->is_object()) continue;
+    const auto v = s->find(key);
+    if (v == s->end() || !v->is_string()) continue;
+    const std::string path = v->get<std::string>();
+    if (path.empty() || std::filesystem::path(path).is_absolute()) continue;
+    config.Set(std::string(section) + "." + key + "=" +
+               nlohmann::json((baseline.root / path).lexically_normal().string()).dump());
+  }
+  PreparedScenario prepared{&scenario, RunConfig::FromConfig(config), ""};
+  nlohmann::json resolved = prepared.config.ToJson();
+  for (const auto& [section, key] : kPathKeys) {
+    if (as_written.contains(section) && as_written[section].contains(key)) {
+      resolved[section][key] = as_written[section][key];
+    }
+  }
+  prepared.config_hash = ConfigHash(resolved);
+  return prepared;
+}
+
+Scenario UpdatedScenario(const Scenario& scenario, const nlohmann::json& metrics,
+                         const std::string& config_hash) {
+  Scenario next = scenario;
+  next.config_hash = config_hash;
+  next.metrics = DefaultBaselineMetrics(metrics);
+  for (auto& [key, t] : next.metrics) {
+    for (const auto& [old_key, old] : scenario.metrics) {
+      if (old_key == key) t.tolerance = old.tolerance, t.relative = old.relative, t.better = old.better;
+    }
+  }
+  return next;
+}
+
+void WriteBaseline(const Baseline& baseline, const std::vector<Scenario>& updated) {
+  nlohmann::json scenarios = nlohmann::json::array();
+  for (const Scenario& s : baseline.scenarios) {
+    const auto u = std::find_if(updated.begin(), updated.end(),
+                                [&](const Scenario& u) { return u.name == s.name; });
+    nlohmann::json j = ToJson(u == updated.end() ? s : *u);
+    j["config"] = std::filesystem::relative(s.config, baseline.root).string();
+    scenarios.push_back(j);
+  }
+  nlohmann::json file = ParseJsonText(ReadTextFile(baseline.file, kMaxJsonFileBytes),
+                                      baseline.file.string());
+  file["scenarios"] = scenarios;
+  WriteFileAtomically(baseline.file, file.dump(2) + "\n");
 }
 
 }  // namespace mmh::pipeline

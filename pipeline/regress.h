@@ -24,6 +24,8 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/animator_run.h"
+
 namespace mmh::pipeline {
 
 enum class Better { kHigher, kLower, kEither };
@@ -85,6 +87,28 @@ std::vector<std::pair<std::string, MetricTolerance>> DefaultBaselineMetrics(
     const nlohmann::json& metrics);
 
 nlohmann::json ToJson(const Scenario& scenario);
+
+// A scenario's run config, read and checked before anything runs, and the hash of its resolved
+// config with the file paths as the scenario writes them (so that it does not depend on where the
+// clone is). Relative file paths of the config (render.story, run.practice, render.proxy,
+// render.trajectory, render.annotation) resolve against the baseline's root, so that `mmh
+// regress` gives the same runs from any working directory.
+struct PreparedScenario {
+  const Scenario* scenario = nullptr;
+  RunConfig config;
+  std::string config_hash;
+};
+PreparedScenario PrepareScenario(const Baseline& baseline, const Scenario& scenario);
+
+// `scenario` with the metrics of a new run (`metrics`: its metrics.json) and the run's config
+// hash: the metrics DefaultBaselineMetrics picks, keeping the tolerances a researcher set for
+// the metrics the scenario already had.
+Scenario UpdatedScenario(const Scenario& scenario, const nlohmann::json& metrics,
+                         const std::string& config_hash);
+
+// Rewrites baseline.json (atomically) with `updated` in place of the scenarios of the same name;
+// the others are kept as they were, and so is every other key of the file.
+void WriteBaseline(const Baseline& baseline, const std::vector<Scenario>& updated);
 
 // A printable table and a tidy CSV of comparisons.
 std::string FormatComparisons(const std::vector<MetricComparison>& comparisons);

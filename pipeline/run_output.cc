@@ -207,20 +207,21 @@ void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run) 
   EnsureDirectory(out);
   WriteMontage(out / "montage", run.montage, "the tracked takes and read annotations");
   WriteMontage(out / "montage_truth", run.truth_montage, "the ground truth");
-  WriteFileAtomically(out / "metrics.json", run.metrics.dump(2) + "\n");
-  WriteFileAtomically(out / "metrics.csv", MetricsToCsv(run.metrics));
+  const nlohmann::json metrics = ToJson(*run.metrics);
+  WriteFileAtomically(out / "metrics.json", metrics.dump(2) + "\n");
+  WriteFileAtomically(out / "metrics.csv", MetricsToCsv(metrics));
 
   std::ostringstream seams;
   seams << "montage,seam,frame,from_take,to_take,position_jump_m,velocity_jump_m_per_s,"
            "angular_velocity_jump_deg_per_s\n";
-  for (const char* which : {"tracked", "truth"}) {
+  for (const auto& [which, montage] : {std::pair{"tracked", &run.metrics->tracked},
+                                        std::pair{"truth", &run.metrics->truth}}) {
     int k = 0;
-    for (const nlohmann::json& s : run.metrics["montage"][which]["seam_list"]) {
-      seams << which << ',' << k++ << ',' << s["frame"].get<int>() << ','
-            << s["from_take"].get<int>() << ',' << s["to_take"].get<int>() << ','
-            << FormatNumber(s["position_jump_m"].get<double>()) << ','
-            << FormatNumber(s["velocity_jump_m_per_s"].get<double>()) << ','
-            << FormatNumber(s["angular_velocity_jump_deg_per_s"].get<double>()) << '\n';
+    for (const SeamJump& s : montage->seam_list) {
+      seams << which << ',' << k++ << ',' << s.frame << ',' << s.from_take << ',' << s.to_take
+            << ',' << FormatNumber(s.position_jump_m) << ','
+            << FormatNumber(s.velocity_jump_m_per_s) << ','
+            << FormatNumber(s.angular_velocity_jump_deg_per_s) << '\n';
     }
   }
   WriteFileAtomically(out / "seams.csv", seams.str());

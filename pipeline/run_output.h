@@ -29,7 +29,8 @@ void WriteTakeRun(const std::filesystem::path& out, const TakeRun& take, bool pr
 // ground truth, malformed rows).
 bool LoadTakeRun(const std::filesystem::path& out, TakeRun& take, bool practice);
 
-// Montages, metrics and tidy tables (the takes are written by WriteTakeRun).
+// Montages, metrics and tidy tables (the takes are written by WriteTakeRun); run.metrics must be
+// set (run.metrics true).
 void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run);
 
 // The tidy metrics table of a metrics.json.

@@ -85,7 +85,7 @@ struct AnimatorOutcome {
   std::optional<sim::Appeal> truth_montage_appeal;
   std::vector<int> montage_takes;        // take of each montage segment
   montage::ComposeSummary montage_summary;
-  nlohmann::json metrics;  // the run's metrics.json
+  std::optional<pipeline::RunMetrics> metrics;  // the run's metrics.json (run.metrics only)
   int rendered_frames = 0;
   pipeline::StageSeconds seconds;
   // Full fidelity only: the tracked takes and readings against their truth, for measuring the

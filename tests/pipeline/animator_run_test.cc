@@ -4,9 +4,11 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
 #include "core/config.h"
 #include "core/error.h"
+#include "pipeline/run_metrics.h"
 #include "tests/test_util.h"
 
 namespace mmh::pipeline {
@@ -44,7 +46,7 @@ TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
   const RunConfig config = ShortConfig(Fidelity::kFast, 0, 3);
   const AnimatorRun a = RunAnimator(config, 2);
   const AnimatorRun b = RunAnimator(config, 2);
-  EXPECT_EQ(a.metrics.dump(), b.metrics.dump());
+  EXPECT_EQ(ToJson(*a.metrics).dump(), ToJson(*b.metrics).dump());
   ASSERT_EQ(a.takes.size(), 3u);
   EXPECT_EQ(a.rendered_frames, 0);
   for (const TakeRun& t : a.takes) {
@@ -54,9 +56,9 @@ TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
   }
   EXPECT_EQ(a.montage_quality.size(), a.montage.trajectory.poses.size());
   // Tracker-sized errors barely change the montage.
-  EXPECT_GT(a.metrics["montage"]["tracked_vs_truth"]["label_agreement"].get<double>(), 0.8);
+  EXPECT_GT(a.metrics->tracked_vs_truth.label_agreement, 0.8);
   // The other animator's run differs.
-  EXPECT_NE(RunAnimator(config, 3).metrics.dump(), a.metrics.dump());
+  EXPECT_NE(ToJson(*RunAnimator(config, 3).metrics).dump(), ToJson(*a.metrics).dump());
 }
 
 // The paper's protocol starts with a Mario practice: recorded and tracked, not composited; the
@@ -74,8 +76,9 @@ TEST(AnimatorRunTest, APracticeTakeComesFirstAndIsNotComposited) {
   EXPECT_EQ(run.takes[0].take, 1);
   EXPECT_GT(run.takes[0].performed.skill, run.practice->performed.skill);
   EXPECT_EQ(run.montage.summary.takes, 3);
-  EXPECT_TRUE(run.metrics.contains("practice"));
-  EXPECT_GT(run.metrics["practice"]["tracking"]["frames"].get<int>(), 100);
+  ASSERT_TRUE(run.metrics->practice.has_value());
+  EXPECT_GT(run.metrics->practice->tracking.summary.frames, 100);
+  EXPECT_TRUE(ToJson(*run.metrics).contains("practice"));
 }
 
 // The full pipeline on the first 75 frames of two takes: rendered, tracked and read, with the
@@ -87,18 +90,18 @@ TEST(AnimatorRunTest, FullFidelityTracksReadsAndDoesNotDependOnThreads) {
       config, 1, {}, [&](const TakeRun& t, bool practice) { done.emplace_back(t.take, practice); });
   EXPECT_EQ(done, (std::vector<std::pair<int, int>>{{0, 0}, {1, 0}}));
   EXPECT_EQ(run.rendered_frames, 2 * 2 * 75);
-  for (const nlohmann::json& t : run.metrics["takes"]) {
-    EXPECT_GE(t["tracking"]["success_rate"].get<double>(), 0.9) << t.dump();
-    EXPECT_LT(t["tracking"]["rotation_deg"]["median"].get<double>(), 3.0);
-    EXPECT_LT(t["tracking"]["translation_m"]["median"].get<double>(), 0.004);
-    EXPECT_LT(t["tracking"]["table_frame_rotation_deg"].get<double>(), 1.0);
-    EXPECT_LT(t["annotation"]["rmse"].get<double>(), 0.3);
-    EXPECT_GT(t["annotation"]["found_share"].get<double>(), 0.95);
+  for (const TakeMetrics& t : run.metrics->takes) {
+    EXPECT_GE(t.tracking.summary.success_rate, 0.9) << t.take;
+    EXPECT_LT(t.tracking.rotation_deg.median, 3.0);
+    EXPECT_LT(t.tracking.translation_m.median, 0.004);
+    EXPECT_LT(t.tracking.table_frame_rotation_deg, 1.0);
+    EXPECT_LT(t.annotation.errors.rmse, 0.3);
+    EXPECT_GT(t.annotation.found_share, 0.95);
   }
   EXPECT_EQ(run.montage.summary.reference_frames, 75);
   {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    EXPECT_EQ(RunAnimator(config, 1).metrics.dump(), run.metrics.dump());
+    EXPECT_EQ(ToJson(*RunAnimator(config, 1).metrics).dump(), ToJson(*run.metrics).dump());
   }
 }
 
