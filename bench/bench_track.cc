@@ -174,8 +174,8 @@ void BM_RealRecording(benchmark::State& state) {
   }();
   const auto& [frames, truth, model, config] = data;
   TrackSetup setup;
-  setup.play_area_width = config.run.play_area_width;
-  setup.play_area_depth = config.run.play_area_depth;
+  setup.play_area_width = config.track.play_area_width;
+  setup.play_area_depth = config.track.play_area_depth;
   int64_t tracked = 0;
   for (auto _ : state) {
     ProxyTracker tracker(model, "foam brick", setup, config.tracker);

@@ -19,6 +19,7 @@
 #include "core/tum_io.h"
 #include "metrics/pose_evaluation.h"
 #include "track/recording.h"
+#include "track/track_session.h"
 
 namespace mmh::cli {
 namespace {
@@ -31,6 +32,7 @@ struct EvalArgs {
   std::string model;
 };
 
+// Section "track" (the keys it shares with mmh track's, and the time tolerance).
 struct EvalRunOptions {
   // The model file's unit [m per unit] (0.001 for a BOP model in millimetres).
   double model_scale = 1.0;
@@ -67,9 +69,10 @@ std::optional<Rigid3> EstimateAt(const Trajectory& estimates, double t, double t
 void RunEval(const EvalArgs& args, const std::vector<std::string>& argv) {
   namespace fs = std::filesystem;
   const Config config = LoadConfig(args.common);
-  config.RequireOnlySections({"run", "eval"});
-  const EvalRunOptions run = config.Get<EvalRunOptions>("run");
-  run.Validate("run");
+  track::RefuseRunSection(config);
+  config.RequireOnlySections({"track", "eval"});
+  const EvalRunOptions run = config.Get<EvalRunOptions>("track");
+  run.Validate("track");
   const metrics::PoseEvaluationOptions options = config.Get<metrics::PoseEvaluationOptions>("eval");
   options.Validate("eval");
   const TriangleMesh model = LoadMesh(args.model, run.model_scale);
@@ -92,7 +95,7 @@ void RunEval(const EvalArgs& args, const std::vector<std::string>& argv) {
     const std::vector<int> ids = recording.object_ids();
     if (object == 0) {
       if (ids.size() != 1) {
-        ThrowBadValue("run.object", "0 (the only one)",
+        ThrowBadValue("track.object", "0 (the only one)",
                       "the id of one of the " + std::to_string(ids.size()) +
                           " objects annotated in " + description);
       }
@@ -100,7 +103,7 @@ void RunEval(const EvalArgs& args, const std::vector<std::string>& argv) {
     }
     const Trajectory truth = recording.Truth(object);
     if (truth.empty()) {
-      ThrowBadValue("run.object", std::to_string(object), "an object annotated in " + description);
+      ThrowBadValue("track.object", std::to_string(object), "an object annotated in " + description);
     }
     RgbdFrame frame;
     for (int k = 0; recording.Next(&frame); ++k) {
@@ -159,7 +162,7 @@ void RunEval(const EvalArgs& args, const std::vector<std::string>& argv) {
   nlohmann::json result = {{"input", description}, {"estimate", args.estimate}, {"objects", {}}};
   for (const auto& o : objects) result["objects"].push_back(metrics::ToJson(o));
   WriteFileAtomically(out / "eval.json", result.dump(2) + "\n");
-  const nlohmann::json resolved = {{"run", ToJson(run)}, {"eval", ToJson(options)}};
+  const nlohmann::json resolved = {{"track", ToJson(run)}, {"eval", ToJson(options)}};
   WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
   WriteFileAtomically(out / "run.json",
                       Provenance(argv, resolved, args.common.threads, nlohmann::json::object())
@@ -198,7 +201,7 @@ void AddEvalCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->add_option("--model", args->model, "The object's mesh (.ply or .obj)")->required();
   cmd->add_option("--truth", args->truth,
                   "Ground truth (TUM) for a TUM folder; default: its groundtruth.txt");
-  cmd->add_option("--config", args->common.config_file, "JSON config: sections run, eval");
+  cmd->add_option("--config", args->common.config_file, "JSON config: sections track, eval");
   cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
       ->take_all();
   cmd->add_option("--out", args->common.out_dir, "Output folder")->required();

@@ -35,41 +35,41 @@ struct TrackArgs {
 
 // A model far larger than any tracked object is almost always one in millimetres read as metres.
 void CheckModelSize(const TriangleMesh& model, const std::string& name,
-                    const track::TrackRunOptions& run) {
+                    const track::TrackOptions& options) {
   const Bounds3 bounds = ComputeBounds(model);
   if (bounds.empty()) return;  // LoadMesh has rejected an empty model already
   const double size = (bounds.max - bounds.min).norm();
-  if (size > run.max_model_size) {
+  if (size > options.max_model_size) {
     throw InputError("--model " + name + ": the model is " + FormatNumber(size) +
-                     " m across (bounding-box diagonal, at run.model_scale " +
-                     FormatNumber(run.model_scale) + "), expected at most run.max_model_size = " +
-                     FormatNumber(run.max_model_size) +
-                     " m: a model in millimetres (BOP) needs --set run.model_scale=0.001");
+                     " m across (bounding-box diagonal, at track.model_scale " +
+                     FormatNumber(options.model_scale) + "), expected at most track.max_model_size = " +
+                     FormatNumber(options.max_model_size) +
+                     " m: a model in millimetres (BOP) needs --set track.model_scale=0.001");
   }
 }
 
-// The object a recording's run follows: run.object, or the only one annotated.
+// The object a recording's run follows: track.object, or the only one annotated.
 int ChooseObject(const track::RecordingFrameSource& recording, int object) {
   const std::vector<int> ids = recording.object_ids();
   std::string list;
   for (int id : ids) list += (list.empty() ? "" : ", ") + std::to_string(id);
   if (object == 0) {
     if (ids.size() == 1) return ids[0];
-    ThrowBadValue("run.object", "0 (the only one)",
+    ThrowBadValue("track.object", "0 (the only one)",
                   "one of the objects annotated in " + recording.Describe() + ": " + list);
   }
   if (std::find(ids.begin(), ids.end(), object) == ids.end()) {
-    ThrowBadValue("run.object", std::to_string(object),
+    ThrowBadValue("track.object", std::to_string(object),
                   "one of the objects annotated in " + recording.Describe() + ": " + list);
   }
   return object;
 }
 
-// The first frame's true pose when run.init is truth.
+// The first frame's true pose when track.init is truth.
 std::optional<Rigid3> FirstTruePose(const std::optional<Trajectory>& truth,
-                                    const track::TrackRunOptions& run) {
-  if (run.init != track::TrackInit::kTruth || !truth) return std::nullopt;
-  if (truth->empty()) throw InputError("run.init = truth: the object has no ground truth");
+                                    const track::TrackOptions& options) {
+  if (options.init != track::TrackInit::kTruth || !truth) return std::nullopt;
+  if (truth->empty()) throw InputError("track.init = truth: the object has no ground truth");
   return truth->poses.front();
 }
 
@@ -85,13 +85,13 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                                                     args.common.threads);
   }
 
-  // Everything is read and checked before the first frame. Slider-only mode (run.proxy false,
+  // Everything is read and checked before the first frame. Slider-only mode (track.proxy false,
   // annotation sessions) needs no model; one given is still read and checked.
-  if (args.model.empty() && track_config.run.proxy) {
-    throw InputError("--model is required (the proxy's mesh) unless --set run.proxy=false");
+  if (args.model.empty() && track_config.track.proxy) {
+    throw InputError("--model is required (the proxy's mesh) unless --set track.proxy=false");
   }
   const TriangleMesh model =
-      args.model.empty() ? TriangleMesh() : LoadMesh(args.model, track_config.run.model_scale);
+      args.model.empty() ? TriangleMesh() : LoadMesh(args.model, track_config.track.model_scale);
   const bool live = args.input == "freenect";
   if (!live && !fs::is_directory(args.input)) {
     ThrowBadValue("--input", "\"" + args.input + "\"",
@@ -107,7 +107,7 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
     setup = track::ReadSetupJson(setup_file);
     calibrated = true;
   }
-  if (track_config.run.proxy) CheckModelSize(model, args.model, track_config.run);
+  if (track_config.track.proxy) CheckModelSize(model, args.model, track_config.track);
   std::unique_ptr<track::FrameSource> source;
   // A real recording with ground truth (BOP scene, YCB-Video folder): the followed object's truth
   // is written beside the trajectory (groundtruth.tum) and may give the first pose.
@@ -116,13 +116,13 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
     source = std::make_unique<track::FreenectFrameSource>(track_config.freenect);
   } else if (track::DetectRecordingLayout(args.input)) {
     auto recording =
-        std::make_unique<track::RecordingFrameSource>(args.input, track_config.run.frame_rate);
-    truth = recording->Truth(ChooseObject(*recording, track_config.run.object));
+        std::make_unique<track::RecordingFrameSource>(args.input, track_config.track.frame_rate);
+    truth = recording->Truth(ChooseObject(*recording, track_config.track.object));
     source = std::move(recording);
   } else {
     source = std::make_unique<track::FolderFrameSource>(
-        args.input, track_config.run.override_intrinsics
-                        ? std::optional<PinholeIntrinsics>(track_config.run.intrinsics)
+        args.input, track_config.track.override_intrinsics
+                        ? std::optional<PinholeIntrinsics>(track_config.track.intrinsics)
                         : std::nullopt);
   }
 
@@ -135,7 +135,7 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                                                      std::cerr << " frames" << std::flush;
                                                    }
                                                  },
-                                                 FirstTruePose(truth, track_config.run));
+                                                 FirstTruePose(truth, track_config.track));
   if (bar) std::cerr << '\n';
 
   const fs::path out = args.common.out_dir;
@@ -158,11 +158,11 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   if (!args.common.quiet) {
     const track::TrackSummary& s = run.summary;
     std::cout << "track: " << s.frames << " frames from " << source->Describe() << ": ";
-    if (track_config.run.proxy) {
+    if (track_config.track.proxy) {
       std::cout << s.tracked << " tracked, " << s.predicted << " predicted, " << s.lost << " lost ("
                 << s.detections << " detections)";
     } else {
-      std::cout << "proxy not tracked (run.proxy=false)";
+      std::cout << "proxy not tracked (track.proxy=false)";
     }
     if (!run.slider.empty()) std::cout << "; slider found in " << s.slider_found;
     std::cout << "; " << (s.seconds > 0 ? s.frames / s.seconds : 0.0) << " frames/s\n";
@@ -177,7 +177,7 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   if (run.summary.frames == 0) {
     throw InputError("--input " + args.input + ": the source delivered no frame");
   }
-  if (!track_config.run.proxy) {
+  if (!track_config.track.proxy) {
     if (run.summary.slider_found == 0) {
       throw std::runtime_error("the slider block was found in no frame; see " +
                                (out / "status.csv").string());
@@ -205,12 +205,12 @@ void AddTrackCommand(CLI::App& app, const std::vector<std::string>& argv) {
       ->required();
   cmd->add_option("--model", args->model,
                   "The proxy's mesh (.ply or .obj), e.g. model.ply of a rendered take; "
-                  "required unless --set run.proxy=false (slider only)");
+                  "required unless --set track.proxy=false (slider only)");
   cmd->add_option("--setup", args->setup,
                   "Setup calibration (scene.json keys: camera_T_table, table.play_area_*, "
                   "table.like_box_*); default: INPUT/scene.json when present");
   AddCommonFlags(cmd, &args->common,
-                 {.config_help = "JSON config: sections run, tracker, slider, freenect"});
+                 {.config_help = "JSON config: sections track, tracker, slider, freenect"});
   cmd->callback([args, argv] { RunTrack(*args, argv); });
 }
 

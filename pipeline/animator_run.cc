@@ -69,9 +69,9 @@ void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOption
   track::TrackConfig config;
   config.tracker = tracker;
   config.slider = slider;
-  config.run.output_frame = track::OutputFrame::kTable;
-  config.run.slider = job.annotation;
-  config.run.proxy = !job.annotation;
+  config.track.output_frame = track::OutputFrame::kTable;
+  config.track.slider = job.annotation;
+  config.track.proxy = !job.annotation;
   // What the tracker is told, as a user calibrates it once before recording (scene.json holds
   // the same): the table's setup and the camera's pose above the table (the tape marks).
   const track::TrackSetup setup{render.scene, job.camera_T_table};

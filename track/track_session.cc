@@ -23,7 +23,7 @@ std::span<const std::pair<TrackInit, const char*>> EnumNames(TrackInit) {
   return kNames;
 }
 
-void TrackRunOptions::Validate(const std::string& prefix) const {
+void TrackOptions::Validate(const std::string& prefix) const {
   RequirePositive(model_scale, prefix + ".model_scale");
   if (object < 0) ThrowBadValue(prefix + ".object", std::to_string(object), ">= 0 (0: the only one)");
   RequirePositive(frame_rate, prefix + ".frame_rate", "Hz");
@@ -36,10 +36,19 @@ void TrackRunOptions::Validate(const std::string& prefix) const {
   }
 }
 
+void RefuseRunSection(const Config& config) {
+  if (config.root().contains("run")) {
+    ThrowBadValue("run", "a section of an mmh track or mmh eval config",
+                  "its keys in the section \"track\" (\"run\" is mmh run's section: "
+                  "rename it, e.g. --set track.object=1)");
+  }
+}
+
 TrackConfig TrackConfig::FromConfig(const Config& config) {
-  config.RequireOnlySections({"run", "tracker", "slider", "freenect"});
+  RefuseRunSection(config);
+  config.RequireOnlySections({"track", "tracker", "slider", "freenect"});
   TrackConfig c;
-  c.run = config.Get<TrackRunOptions>("run");
+  c.track = config.Get<TrackOptions>("track");
   c.tracker = config.Get<ProxyTrackerOptions>("tracker");
   c.slider = config.Get<SliderReaderOptions>("slider");
   c.freenect = config.Get<FreenectOptions>("freenect");
@@ -47,7 +56,7 @@ TrackConfig TrackConfig::FromConfig(const Config& config) {
 }
 
 nlohmann::json TrackConfig::ToJson() const {
-  return {{"run", mmh::ToJson(run)},
+  return {{"track", mmh::ToJson(track)},
           {"tracker", mmh::ToJson(tracker)},
           {"slider", mmh::ToJson(slider)},
           {"freenect", mmh::ToJson(freenect)}};
@@ -62,7 +71,7 @@ nlohmann::json TrackSummary::ToJson() const {
 
 namespace {
 
-// Slider-only mode (TrackRunOptions::proxy false): the table frame from one RANSAC plane, found on
+// Slider-only mode (TrackOptions::proxy false): the table frame from one RANSAC plane, found on
 // the first frame that has one and retried every kPlaneRetryFrames frames until then (a plane per
 // frame would cost more than the slider reading itself).
 class SliderOnlyTable {
@@ -117,19 +126,19 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
                      const std::function<void(int, int)>& progress,
                      const std::optional<Rigid3>& initial_camera_T_proxy) {
-  config.run.Validate("run");
-  if (config.run.init == TrackInit::kTruth && !initial_camera_T_proxy && config.run.proxy) {
-    throw InputError("run.init = truth needs a recording with ground truth (a BOP scene or a "
+  config.track.Validate("track");
+  if (config.track.init == TrackInit::kTruth && !initial_camera_T_proxy && config.track.proxy) {
+    throw InputError("track.init = truth needs a recording with ground truth (a BOP scene or a "
                      "YCB-Video folder) for the first frame's pose");
   }
-  const bool slider_only = !config.run.proxy;
+  const bool slider_only = !config.track.proxy;
   if (slider_only) {
-    if (!config.run.slider) {
-      ThrowBadValue("run.slider", "false", "true when run.proxy is false (nothing would be read)");
+    if (!config.track.slider) {
+      ThrowBadValue("track.slider", "false", "true when track.proxy is false (nothing would be read)");
     }
     if (!setup_calibrated || !setup.has_like_box()) {
       throw InputError(
-          "run.proxy = false (slider-only mode) reads only the slider, which needs a setup "
+          "track.proxy = false (slider-only mode) reads only the slider, which needs a setup "
           "calibration with a Like box (--setup FILE or INPUT/scene.json, table.like_box_length "
           "> 0); " +
           std::string(setup_calibrated ? "the setup's like_box_length is 0"
@@ -141,28 +150,28 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
   // Slider-only mode builds no proxy model (the model may be empty).
   std::optional<ProxyTracker> tracker;
   if (!slider_only) {
-    // A recording's play area (TrackRunOptions::play_area_*) replaces the setup's.
+    // A recording's play area (TrackOptions::play_area_*) replaces the setup's.
     TrackSetup tracked_setup = setup;
-    if (config.run.play_area_width > 0) tracked_setup.play_area_width = config.run.play_area_width;
-    if (config.run.play_area_depth > 0) tracked_setup.play_area_depth = config.run.play_area_depth;
+    if (config.track.play_area_width > 0) tracked_setup.play_area_width = config.track.play_area_width;
+    if (config.track.play_area_depth > 0) tracked_setup.play_area_depth = config.track.play_area_depth;
     tracker.emplace(model, model_name, tracked_setup, config.tracker);
-    if (config.run.init == TrackInit::kTruth && initial_camera_T_proxy) {
+    if (config.track.init == TrackInit::kTruth && initial_camera_T_proxy) {
       tracker->Initialize(*initial_camera_T_proxy);
     }
   }
   SliderOnlyTable slider_table(config.tracker.table, setup.camera_T_table);
   std::optional<SliderReader> slider;
-  if (config.run.slider && setup_calibrated && setup.has_like_box()) {
+  if (config.track.slider && setup_calibrated && setup.has_like_box()) {
     slider.emplace(setup, config.slider);
   }
   TrackRun run;
-  run.summary.init = config.run.init == TrackInit::kTruth ? "truth" : "detection";
+  run.summary.init = config.track.init == TrackInit::kTruth ? "truth" : "detection";
   RgbdFrame frame;
   double last_value = 0.0;
   int unreadable = 0;
   std::string first_unreadable;
   using Clock = std::chrono::steady_clock;
-  while ((config.run.max_frames == 0 || run.summary.frames < config.run.max_frames) &&
+  while ((config.track.max_frames == 0 || run.summary.frames < config.track.max_frames) &&
          source.Next(&frame)) {
     const auto start = Clock::now();
     const bool readable = source.frame_error().empty();
@@ -208,7 +217,7 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
     run.summary.detections += result.detected;
     if (result.status != TrackStatus::kLost) {
       Rigid3 pose = result.camera_T_proxy;
-      if (config.run.output_frame == OutputFrame::kTable && tracker->camera_T_table()) {
+      if (config.track.output_frame == OutputFrame::kTable && tracker->camera_T_table()) {
         pose = tracker->camera_T_table()->Inverse() * pose;
       }
       run.trajectory.timestamps.push_back(frame.timestamp);
@@ -278,7 +287,7 @@ std::vector<std::string> WriteTrackRun(const std::filesystem::path& out, const T
   }
   if (!run.trajectory.empty()) {
     WriteTum(out / "trajectory.tum", run.trajectory,
-             std::string(config.run.output_frame == OutputFrame::kCamera ? "camera_T_proxy"
+             std::string(config.track.output_frame == OutputFrame::kCamera ? "camera_T_proxy"
                                                                          : "table_T_proxy") +
                  " per tracked or predicted frame; lost frames are left out (status.csv)");
     written.push_back("trajectory.tum");

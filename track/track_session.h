@@ -35,7 +35,7 @@ std::span<const std::pair<OutputFrame, const char*>> EnumNames(OutputFrame);
 enum class TrackInit { kDetection, kTruth };
 std::span<const std::pair<TrackInit, const char*>> EnumNames(TrackInit);
 
-struct TrackRunOptions {
+struct TrackOptions {
   OutputFrame output_frame = OutputFrame::kCamera;
   // The model file's unit [m per unit] (0.001 for a model in millimetres).
   double model_scale = 1.0;
@@ -88,13 +88,18 @@ struct TrackRunOptions {
   void Validate(const std::string& prefix) const;
 };
 
-// Every section of a track config: "run", "tracker", "slider", "freenect".
+// mmh track's and mmh eval's config: refuses a section "run" (what "track" was called before
+// 2026-11; "run" is mmh run's section) with the hint to rename it.
+void RefuseRunSection(const Config& config);
+
+// Every section of a track config: "track", "tracker", "slider", "freenect".
 struct TrackConfig {
-  TrackRunOptions run;
+  TrackOptions track;
   ProxyTrackerOptions tracker;
   SliderReaderOptions slider;
   FreenectOptions freenect;
 
+  // InputError for a section "run" (the name of this section before 2026-11) with the hint.
   static TrackConfig FromConfig(const Config& config);
   nlohmann::json ToJson() const;
 };
@@ -128,9 +133,9 @@ struct TrackRun {
 // Tracks every frame of `source` (progress(done, total or -1) after each). The setup is the
 // calibration (track/setup.h); slider reading needs one with a Like box and setup_calibrated
 // (without a calibration the table frame is the estimated one, where the Like box is unknown).
-// With config.run.proxy false (slider-only mode) `model` is not used (it may be empty), and a
-// missing calibration or Like box, or run.slider false, is an InputError before the first frame.
-// `initial_camera_T_proxy`: the first frame's pose when config.run.init is truth (required then).
+// With config.track.proxy false (slider-only mode) `model` is not used (it may be empty), and a
+// missing calibration or Like box, or track.slider false, is an InputError before the first frame.
+// `initial_camera_T_proxy`: the first frame's pose when config.track.init is truth (required then).
 TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::string& model_name,
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
                      const std::function<void(int, int)>& progress = {},

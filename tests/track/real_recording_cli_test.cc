@@ -33,8 +33,8 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
   const fs::path out = dir / ("track_" + init);
   const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
                             (kReal / "models" / model).string() + " --config " + kPreset +
-                            " --set run.object=" + std::to_string(object) +
-                            " --set run.init=\\\"" + init + "\\\" --out " + out.string());
+                            " --set track.object=" + std::to_string(object) +
+                            " --set track.init=\\\"" + init + "\\\" --out " + out.string());
   EXPECT_EQ(track.exit_code, 0) << track.output;
   const auto summary = nlohmann::json::parse(ReadBytes(out / "track_summary.json"));
   EXPECT_EQ(summary["init"], init);
@@ -42,7 +42,7 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
   const fs::path eval = dir / ("eval_" + init);
   const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model " +
                              (kReal / "models" / model).string() + " --estimate " +
-                             (out / "trajectory.tum").string() + " --set run.object=" +
+                             (out / "trajectory.tum").string() + " --set track.object=" +
                              std::to_string(object) + " --out " + eval.string());
   EXPECT_EQ(result.exit_code, 0) << result.output;
   const auto json = nlohmann::json::parse(ReadBytes(eval / "eval.json"));
@@ -74,13 +74,13 @@ TEST(RealRecordingCliTest, EvalOfTheTruthItselfIsPerfect) {
   // The ground truth as the estimate: every error 0, every recall 1.
   const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
                             (kReal / "models" / "061_foam_brick.obj").string() + " --config " +
-                            kPreset + " --set run.object=21 --set run.init=\\\"truth\\\" --out " +
+                            kPreset + " --set track.object=21 --set track.init=\\\"truth\\\" --out " +
                             (dir / "t").string());
   ASSERT_EQ(track.exit_code, 0) << track.output;
   const auto result = RunMmh("eval --input " + kVideo.string() + " --model " +
                              (kReal / "models" / "061_foam_brick.obj").string() + " --estimate " +
                              (dir / "t" / "groundtruth.tum").string() +
-                             " --set run.object=21 --out " + (dir / "e").string());
+                             " --set track.object=21 --out " + (dir / "e").string());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const auto o = nlohmann::json::parse(ReadBytes(dir / "e" / "eval.json"))["objects"][0];
   EXPECT_EQ(o["ar"], 1.0);
@@ -94,11 +94,11 @@ TEST(RealRecordingCliTest, BadInputsNameTheFileAndTheValue) {
   // A model 1000 times too big (millimetres read as metres).
   const auto big = RunMmh("track --input " + kVideo.string() + " --model " +
                           (kReal / "models" / "061_foam_brick.obj").string() + " --config " +
-                          kPreset + " --set run.object=21 --set run.model_scale=1000 --out " +
+                          kPreset + " --set track.object=21 --set track.model_scale=1000 --out " +
                           (dir / "a").string());
   EXPECT_EQ(big.exit_code, 2) << big.output;
   EXPECT_THAT(big.output, HasSubstr("061_foam_brick.obj: the model is"));
-  EXPECT_THAT(big.output, HasSubstr("run.model_scale=0.001"));
+  EXPECT_THAT(big.output, HasSubstr("track.model_scale=0.001"));
   EXPECT_FALSE(fs::exists(dir / "a"));
   // Several objects and none chosen.
   const auto none = RunMmh("track --input " + kVideo.string() + " --model " +

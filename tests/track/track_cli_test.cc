@@ -81,7 +81,7 @@ TEST(TrackCliTest, TracksARenderedTakeFromItsFolder) {
   // Same input and config: the same bytes (timings only in run.json).
   const auto again = RunMmh("track --quiet --input " + take.string() + " --model " +
                             (take / "model.ply").string() + " --out " + (dir / "again").string() +
-                            " --set run.output_frame=camera");
+                            " --set track.output_frame=camera");
   ASSERT_EQ(again.exit_code, 0) << again.output;
   for (const char* name : {"trajectory.tum", "status.csv", "annotation.csv", "track_summary.json",
                            "config.resolved.json"}) {
@@ -90,7 +90,7 @@ TEST(TrackCliTest, TracksARenderedTakeFromItsFolder) {
 }
 
 // An annotation session (the proxy rests outside the play area, the hand moves the slider block):
-// the default mode tracks no proxy (exit 1); slider-only mode (run.proxy=false, no model needed)
+// the default mode tracks no proxy (exit 1); slider-only mode (track.proxy=false, no model needed)
 // exits 0 with annotation.csv within 0.3 RMSE of the rendered block's values and no trajectory.
 TEST(TrackCliTest, SliderOnlyModeOnAnAnnotationSession) {
   TempDir dir;
@@ -105,11 +105,11 @@ TEST(TrackCliTest, SliderOnlyModeOnAnAnnotationSession) {
   ASSERT_EQ(render.exit_code, 0) << render.output;
   const std::string input = "track --input " + take.string() + " --out ";
   auto tracked = RunMmh(input + (dir / "proxy").string() + " --model " +
-                        (take / "model.ply").string() + " --set run.max_frames=5");
+                        (take / "model.ply").string() + " --set track.max_frames=5");
   EXPECT_EQ(tracked.exit_code, 1) << tracked.output;
-  auto slider = RunMmh(input + (dir / "slider").string() + " --set run.proxy=false");
+  auto slider = RunMmh(input + (dir / "slider").string() + " --set track.proxy=false");
   ASSERT_EQ(slider.exit_code, 0) << slider.output;
-  EXPECT_THAT(slider.output, HasSubstr("proxy not tracked (run.proxy=false); slider found in 30"));
+  EXPECT_THAT(slider.output, HasSubstr("proxy not tracked (track.proxy=false); slider found in 30"));
   EXPECT_FALSE(fs::exists(dir / "slider" / "trajectory.tum"));
   const Annotation read = ReadAnnotationCsv(dir / "slider" / "annotation.csv");
   const Annotation truth = ReadAnnotationCsv(take / "slider.csv");
@@ -123,7 +123,7 @@ TEST(TrackCliTest, SliderOnlyModeOnAnAnnotationSession) {
   EXPECT_THAT(status[1], HasSubstr("proxy not tracked"));
   // Without the setup calibration (no Like box to read): a clear error, nothing written.
   fs::remove(take / "scene.json");
-  auto no_setup = RunMmh(input + (dir / "none").string() + " --set run.proxy=false");
+  auto no_setup = RunMmh(input + (dir / "none").string() + " --set track.proxy=false");
   EXPECT_EQ(no_setup.exit_code, 2) << no_setup.output;
   EXPECT_THAT(no_setup.output, HasSubstr("needs a setup calibration with a Like box"));
   EXPECT_FALSE(fs::exists(dir / "none" / "status.csv"));
@@ -138,7 +138,7 @@ TEST(TrackCliTest, TableFrameOutput) {
   TempDir dir;
   const auto result = RunMmh("track --quiet --input " + take.string() + " --model " +
                              (take / "model.ply").string() + " --out " + (dir / "out").string() +
-                             " --set run.output_frame=table --set run.max_frames=10");
+                             " --set track.output_frame=table --set track.max_frames=10");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const Trajectory tracked = ReadTum(dir / "out" / "trajectory.tum");
   ASSERT_EQ(tracked.size(), 10u);
@@ -158,7 +158,7 @@ TEST(TrackCliTest, FreenectInputRunsOnAFakenectDump) {
   const auto result =
       RunMmh("track --input freenect --model " + (RenderedTake() / "model.ply").string() +
              " --setup " + (RenderedTake() / "scene.json").string() + " --out " +
-             (dir / "out").string() + " --set run.max_frames=20 2>&1; true");
+             (dir / "out").string() + " --set track.max_frames=20 2>&1; true");
   // The real libfreenect: no Kinect here, a clear error.
   EXPECT_THAT(result.output, HasSubstr("freenect"));
   const std::string with_fakenect =
@@ -167,7 +167,7 @@ TEST(TrackCliTest, FreenectInputRunsOnAFakenectDump) {
       std::string(MMH_BINARY) + " track --input freenect --model " +
       (RenderedTake() / "model.ply").string() + " --setup " +
       (RenderedTake() / "scene.json").string() + " --out " + (dir / "live").string() +
-      " --set run.max_frames=20 > " + (dir / "log").string() + " 2>&1";
+      " --set track.max_frames=20 > " + (dir / "log").string() + " 2>&1";
   ASSERT_EQ(std::system(with_fakenect.c_str()), 0) << ReadBytes(dir / "log");
   EXPECT_THAT(ReadBytes(dir / "log"), HasSubstr("20 frames from freenect device 0: 20 tracked"));
   const Trajectory tracked = ReadTum(dir / "live" / "trajectory.tum");
@@ -235,7 +235,7 @@ TEST(TrackCliTest, BadFramesAreLostNotFatal) {
   WriteDepthPng16(depth[15], DepthImage{320, 240, std::vector<uint16_t>(320 * 240, 5000)});
   const auto result =
       RunMmh("track --input " + take.string() + " --model " + (take / "model.ply").string() +
-             " --out " + (dir / "out").string() + " --set run.max_frames=30");
+             " --out " + (dir / "out").string() + " --set track.max_frames=30");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const auto status = Lines(ReadBytes(dir / "out" / "status.csv"));
   ASSERT_EQ(status.size(), 31u);
@@ -268,7 +268,7 @@ TEST(TrackCliTest, AModelThatDoesNotMatchIsLostEverywhere) {
   WritePly(cube, dir / "cube.ply");
   const auto result =
       RunMmh("track --input " + take.string() + " --model " + (dir / "cube.ply").string() +
-             " --out " + (dir / "out").string() + " --set run.max_frames=10");
+             " --out " + (dir / "out").string() + " --set track.max_frames=10");
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_THAT(result.output, HasSubstr("no frame was tracked"));
   const auto status = Lines(ReadBytes(dir / "out" / "status.csv"));

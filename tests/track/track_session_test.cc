@@ -36,7 +36,7 @@ TEST(TrackSessionTest, SliderOnlyModeReadsAnAnnotationSession) {
       },
       "annotation session", frames);
   TrackConfig config;
-  config.run.proxy = false;
+  config.track.proxy = false;
   // No model: slider-only mode does not build one.
   const TrackRun run = RunTracking(source, TriangleMesh(), "", take.Setup(), true, config);
   ASSERT_EQ(static_cast<int>(run.frames.size()), frames);
@@ -67,7 +67,7 @@ TEST(TrackSessionTest, SliderOnlyModeNeedsALikeBoxAndTheSlider) {
   test_take::SimTake take;
   CallbackFrameSource source([&](int i, RgbdFrame* frame) { return false; }, "none", 0);
   TrackConfig config;
-  config.run.proxy = false;
+  config.track.proxy = false;
   EXPECT_THAT(
       ErrorOf([&] { RunTracking(source, TriangleMesh(), "", take.Setup(), false, config); }),
       HasSubstr("no setup calibration was given"));
@@ -75,9 +75,9 @@ TEST(TrackSessionTest, SliderOnlyModeNeedsALikeBoxAndTheSlider) {
   no_box.like_box_length = 0;
   EXPECT_THAT(ErrorOf([&] { RunTracking(source, TriangleMesh(), "", no_box, true, config); }),
               HasSubstr("like_box_length is 0"));
-  config.run.slider = false;
+  config.track.slider = false;
   EXPECT_THAT(ErrorOf([&] { RunTracking(source, TriangleMesh(), "", take.Setup(), true, config); }),
-              HasSubstr("run.slider"));
+              HasSubstr("track.slider"));
 }
 
 }  // namespace
