@@ -14,6 +14,7 @@
 #include "pipeline/run_metrics.h"
 #include "sim/kinect_sensor.h"
 #include "sim/props.h"
+#include "sim/session_script.h"
 #include "people/random.h"
 #include "people/viewer.h"
 #include "track/frame_source.h"
@@ -39,9 +40,7 @@ struct SessionJob {
   bool annotation = false;
   const TriangleMesh* model = nullptr;
   std::string model_name;
-  std::vector<Rigid3> table_T_proxy;
-  std::vector<double> slider;
-  sim::TableTopScene::Hand hand = sim::TableTopScene::Hand::kOnProxy;
+  sim::SessionFrames frames;
   // Results.
   track::TrackRun run;
   Rigid3 camera_T_table;  // the true one (for the ground truth in the camera frame)
@@ -57,11 +56,11 @@ void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOption
   sim::TableTopScene scene(render, *job.model);
   sim::KinectSensor sensor(render.sensor, &scene.scene(), scene.table_T_camera());
   job.camera_T_table = sensor.world_T_depth_camera().Inverse();
-  const int frames = static_cast<int>(job.table_T_proxy.size());
+  const int frames = static_cast<int>(job.frames.table_T_proxy.size());
   track::CallbackFrameSource source(
       [&](int i, RgbdFrame* frame) {
         if (i >= frames) return false;
-        scene.SetFrame(job.table_T_proxy[i], job.slider[i], job.hand);
+        scene.SetFrame(job.frames.table_T_proxy[i], job.frames.slider[i], job.frames.hand);
         sensor.Render(i, render.render.mode, frame);
         return true;
       },
@@ -190,13 +189,8 @@ RunConfig RunConfig::FromConfig(const Config& config,
     ThrowBadValue("render.story", "\"\"", "a story file (e.g. configs/stories/soldier.json)");
   }
   // The stories are read now, so that a missing or broken one stops the run before any output.
-  const sim::Story story = sim::LoadStory(c.render.render.story, c.render.scene);
-  if (c.render.render.object < 0 ||
-      c.render.render.object >= static_cast<int>(story.objects.size())) {
-    ThrowBadValue("render.object", std::to_string(c.render.render.object),
-                  "an object of " + c.render.render.story + " (0.." +
-                      std::to_string(story.objects.size() - 1) + ")");
-  }
+  sim::StoryScript(c.render, c.render.render.story, c.render.render.object,
+                   c.render.render.animator);
   // Takes the montage would refuse (no longer than the shortest segment) are refused now, before
   // anything is performed, rendered or tracked.
   const int d = c.montage.labelling.min_segment_length;
@@ -205,7 +199,9 @@ RunConfig RunConfig::FromConfig(const Config& config,
                   "0 (whole takes) or more than montage.labelling.min_segment_length = " +
                       std::to_string(d) + " frames (the shortest segment a montage may take)");
   }
-  if (!c.run.practice.empty()) sim::LoadStory(c.run.practice, c.render.scene);
+  if (!c.run.practice.empty()) {
+    sim::StoryScript(c.render, c.run.practice, 0, c.render.render.animator, "run.practice's object");
+  }
   if (std::abs(c.render.performance.frame_rate - c.render.sensor.frame_rate) > 1e-9) {
     ThrowBadValue("performance.frame_rate", FormatNumber(c.render.performance.frame_rate),
                   "the sensor's frame rate (sensor.frame_rate = " +
@@ -254,32 +250,24 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
 
   // Perform: the practice take, the takes, and the annotation sessions (cheap; sequential).
   auto t0 = Clock::now();
-  const sim::Story story = sim::LoadStory(render.render.story, render.scene);
-  const int object = render.render.object;
-  if (object < 0 || object >= static_cast<int>(story.objects.size())) {
-    ThrowBadValue("render.object", std::to_string(object),
-                  "an object of " + render.render.story + " (0.." +
-                      std::to_string(story.objects.size() - 1) + ")");
-  }
-  result.participant = sim::DrawParticipant(render.population, animator);
+  const sim::StoryScript script(render, render.render.story, render.render.object, animator);
+  result.participant = script.participant();
   const std::uint64_t seed = sim::ParticipantSeed(render.population, animator);
-  std::optional<sim::Story> practice_story;
+  std::optional<sim::StoryScript> practice_script;
   const int practice_takes = options.practice.empty() ? 0 : 1;
   std::vector<TakeRun> takes;  // the practice take first
   if (practice_takes) {
-    practice_story = sim::LoadStory(options.practice, render.scene);
+    practice_script.emplace(render, options.practice, 0, animator, "run.practice's object");
     TakeRun t;
     t.take = 0;
-    t.performed = sim::PerformTake(*practice_story, 0, result.participant.animator, 0,
-                                   render.performance, seed);
+    t.performed = practice_script->Perform(0);
     takes.push_back(std::move(t));
   }
   for (int k = 0; k < options.takes; ++k) {
     TakeRun t;
     t.take = practice_takes + k;
-    t.performed = sim::PerformTake(story, object, result.participant.animator, t.take,
-                                   render.performance, seed);
-    t.annotation = sim::AnnotateStoryTake(render, result.participant, t.performed);
+    t.performed = script.Perform(t.take);
+    t.annotation = script.Annotate(t.performed);
     takes.push_back(std::move(t));
   }
   // render.frames (when set) shortens every session: a quick look, or a short regression test.
@@ -321,14 +309,13 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
   // The proxies' models: rendered by the sensor, given to the tracker, and the metrics' points.
   std::vector<TriangleMesh> models;
   std::vector<std::string> model_names;
-  const std::string main_proxy = render.render.proxy.empty()
-                                     ? sim::StoryProxyFile(render.render.story, story, object)
-                                     : render.render.proxy;
+  const std::string main_proxy =
+      render.render.proxy.empty() ? script.ProxyFile() : render.render.proxy;
   models.push_back(sim::LoadProxyModel(main_proxy, render.render.proxy_scale));
   result.proxy_model = models.back();
   model_names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
   if (practice_takes) {
-    const std::string practice_proxy = sim::StoryProxyFile(options.practice, *practice_story, 0);
+    const std::string practice_proxy = practice_script->ProxyFile();
     models.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
     model_names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
   }
@@ -344,12 +331,12 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
       const bool is_practice = practice_takes && slot == 0;
       const int model = is_practice ? 1 : 0;
       const int frames = static_cast<int>(t.truth.poses.size());
+      const sim::StoryScript& take_script = is_practice ? *practice_script : script;
       SessionJob recording;
       recording.take_slot = static_cast<int>(slot);
       recording.model = &models[model];
       recording.model_name = model_names[model];
-      recording.table_T_proxy = t.truth.poses;
-      recording.slider.assign(frames, render.annotator.start_value);
+      recording.frames = take_script.RecordingFrames(t.performed, frames);
       jobs.push_back(std::move(recording));
       total_frames += frames;
       if (!is_practice) {
@@ -358,9 +345,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
         annotation.annotation = true;
         annotation.model = &models[model];
         annotation.model_name = model_names[model];
-        annotation.table_T_proxy.assign(frames, sim::RestingTableTProxy());
-        annotation.slider = t.truth_annotation.values;
-        annotation.hand = sim::TableTopScene::Hand::kOnSlider;
+        annotation.frames = take_script.AnnotationFrames(t.annotation, frames);
         jobs.push_back(std::move(annotation));
         total_frames += frames;
       }
@@ -369,7 +354,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     // against the slider reader), each worker taking the next job when it is free: the greedy
     // longest-processing-time schedule keeps both cores busy to the end.
     auto cost = [&](const SessionJob& job) {
-      return static_cast<double>(job.table_T_proxy.size()) * (job.annotation ? 1.0 : 1.6);
+      return static_cast<double>(job.frames.table_T_proxy.size()) * (job.annotation ? 1.0 : 1.6);
     };
     std::vector<int> order(jobs.size());
     for (size_t i = 0; i < jobs.size(); ++i) order[i] = static_cast<int>(i);

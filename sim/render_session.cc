@@ -20,6 +20,7 @@
 #include "sim/bop_writer.h"
 #include "sim/duplo.h"
 #include "sim/fakenect_writer.h"
+#include "sim/session_script.h"
 #include "people/random.h"
 #include "people/story.h"
 
@@ -36,8 +37,6 @@ constexpr std::array<std::pair<RenderSession, const char*>, 2> kRenderSessionNam
     {RenderSession::kRecording, "recording"},
     {RenderSession::kAnnotation, "annotation"},
 }};
-// Where the proxy rests during an annotation session: on the table left of the play area.
-constexpr double kRestingProxyX = -0.32;
 
 Eigen::Quaterniond Yaw(double angle) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()));
@@ -258,8 +257,7 @@ struct Motion {
   std::vector<double> slider;
   TableTopScene::Hand hand = TableTopScene::Hand::kOnProxy;
   // Story-driven recordings.
-  std::optional<Story> story;
-  std::optional<Participant> participant;
+  std::optional<StoryScript> script;
   std::optional<PerformedTake> take;
   std::optional<AnnotationSession> annotation;
 };
@@ -269,30 +267,21 @@ Motion ResolveMotion(const RenderConfig& config) {
   Motion motion;
   motion.proxy = r.proxy;
   if (!r.story.empty()) {
-    motion.story = LoadStory(r.story, config.scene);
-    const Story& story = *motion.story;
-    if (r.object >= static_cast<int>(story.objects.size())) {
-      ThrowBadValue(
-          "render.object", std::to_string(r.object),
-          "an object of " + r.story + " (0.." + std::to_string(story.objects.size() - 1) + ")");
-    }
-    motion.participant = DrawParticipant(config.population, r.animator);
-    const std::uint64_t seed = ParticipantSeed(config.population, r.animator);
-    motion.take = PerformTake(story, r.object, motion.participant->animator, r.take,
-                              config.performance, seed);
-    if (r.proxy.empty()) motion.proxy = StoryProxyFile(r.story, story, r.object);
+    const StoryScript& script = motion.script.emplace(config, r.story, r.object, r.animator);
+    motion.take = script.Perform(r.take);
+    if (r.proxy.empty()) motion.proxy = script.ProxyFile();
     const int take_frames = motion.take->frames();
     motion.frames = r.frames == 0 ? take_frames : std::min(r.frames, take_frames);
+    SessionFrames frames;
     if (r.session == RenderSession::kRecording) {
-      motion.table_T_proxy = motion.take->table_T_proxy.poses;
-      motion.slider.assign(take_frames, config.annotator.start_value);
+      frames = script.RecordingFrames(*motion.take, motion.frames);
     } else {
-      // The take plays on screen; the animator's hand is on the block; the proxy rests.
-      motion.annotation = AnnotateStoryTake(config, *motion.participant, *motion.take);
-      motion.slider = motion.annotation->slider;
-      motion.table_T_proxy.assign(take_frames, RestingTableTProxy());
-      motion.hand = TableTopScene::Hand::kOnSlider;
+      motion.annotation = script.Annotate(*motion.take);
+      frames = script.AnnotationFrames(*motion.annotation, motion.frames);
     }
+    motion.table_T_proxy = std::move(frames.table_T_proxy);
+    motion.slider = std::move(frames.slider);
+    motion.hand = frames.hand;
     return motion;
   }
   std::optional<Trajectory> trajectory;
@@ -327,7 +316,7 @@ Motion ResolveMotion(const RenderConfig& config) {
 void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
                      const std::filesystem::path& out) {
   const PerformedTake& take = *motion.take;
-  const StoryObject& object = motion.story->objects[take.object];
+  const StoryObject& object = motion.script->story().objects[take.object];
   const double fps = config.performance.frame_rate;
   std::string csv =
       "frame,timestamp,beat,script_kind,performed_kind,progress,quality,fidelity,path,steadiness,"
@@ -359,37 +348,15 @@ void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
   WriteFileAtomically(out / "flaws.csv", flaws);
   WriteTum(out / "take.tum", take.table_T_proxy);
   nlohmann::json participant;
-  participant["index"] = motion.participant->index;
-  participant["animator"] = mmh::ToJson(motion.participant->animator);
-  participant["annotator"] = mmh::ToJson(motion.participant->annotator);
+  participant["index"] = motion.script->participant().index;
+  participant["animator"] = mmh::ToJson(motion.script->participant().animator);
+  participant["annotator"] = mmh::ToJson(motion.script->participant().annotator);
   participant["take"] = take.take;
   participant["skill_at_take"] = take.skill;
   WriteFileAtomically(out / "participant.json", participant.dump(2) + "\n");
 }
 
 }  // namespace
-
-std::string StoryProxyFile(const std::string& story_file, const Story& story, int object) {
-  const std::string& proxy = story.objects.at(object).proxy;
-  if (proxy.empty()) return "";
-  const std::filesystem::path path(proxy);
-  if (path.is_absolute()) return proxy;
-  return (std::filesystem::path(story_file).parent_path() / path).lexically_normal().string();
-}
-
-AnnotationSession AnnotateStoryTake(const RenderConfig& config, const Participant& participant,
-                                    const PerformedTake& take) {
-  AnnotatorOptions annotator = config.annotator;
-  annotator.frame_rate = config.performance.frame_rate;
-  const std::uint64_t seed = ParticipantSeed(config.population, participant.index);
-  return AnnotateTake(take.quality.quality, participant.annotator, annotator,
-                      DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(take.object),
-                                        static_cast<std::uint64_t>(take.take)}));
-}
-
-Rigid3 RestingTableTProxy() {
-  return Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(kRestingProxyX, 0, 0));
-}
 
 RenderSummary RenderSequence(
     const RenderConfig& config, const std::filesystem::path& out,

@@ -182,16 +182,9 @@ struct RenderSummary {
   nlohmann::json ToJson() const;
 };
 
-// The pieces of a story-driven recording, shared with the pipeline (pipeline/animator_run.h) so
-// that `mmh run` renders exactly the frames `mmh render` renders for the same participant, take and
-// session.
-// The proxy model file of `story.objects[object]` (relative paths are relative to the story file).
-std::string StoryProxyFile(const std::string& story_file, const Story& story, int object);
-// The participant's annotation session of a performed take (their slider while it plays).
-AnnotationSession AnnotateStoryTake(const RenderConfig& config, const Participant& participant,
-                                    const PerformedTake& take);
-// Where the proxy rests during an annotation session: on the table left of the play area.
-Rigid3 RestingTableTProxy();
+// A story-driven recording's sessions are scripted by sim/session_script.h (shared with `mmh run`,
+// so that it renders exactly the frames `mmh render` renders for the same participant, take and
+// session).
 
 // Renders the sequence and writes `out` (a TUM RGB-D folder: rgb/, depth/, rgb.txt, depth.txt,
 // groundtruth.txt = camera_T_proxy of the depth camera, camera.json), plus model.ply (the proxy's

@@ -19,6 +19,7 @@
 #include "people/performance.h"
 #include "people/population.h"
 #include "sim/render_session.h"
+#include "sim/session_script.h"
 #include "people/story.h"
 #include "track/setup.h"
 
@@ -88,12 +89,9 @@ inline SimTake SoldierStorySession(const std::string& source, int animator, int 
   config.render.animator = animator;
   config.render.take = take;
   config.render.session = session;
-  const sim::Story story = sim::LoadStory(config.render.story, config.scene);
-  const sim::Participant participant = sim::DrawParticipant(config.population, animator);
-  auto performed = std::make_shared<const sim::PerformedTake>(
-      sim::PerformTake(story, 0, participant.animator, take, config.performance,
-                       sim::ParticipantSeed(config.population, animator)));
-  config.render.proxy = sim::StoryProxyFile(config.render.story, story, 0);
+  const sim::StoryScript script(config, config.render.story, 0, animator);
+  auto performed = std::make_shared<const sim::PerformedTake>(script.Perform(take));
+  config.render.proxy = script.ProxyFile();
   *frames = performed->frames();
   const double rate = config.sensor.frame_rate;
   const int last = *frames - 1;
@@ -107,8 +105,7 @@ inline SimTake SoldierStorySession(const std::string& source, int animator, int 
         [performed, frame_at](double t) { return performed->table_T_proxy.poses[frame_at(t)]; },
         [rest](double) { return rest; });
   }
-  auto slider = std::make_shared<const std::vector<double>>(
-      sim::AnnotateStoryTake(config, participant, *performed).slider);
+  auto slider = std::make_shared<const std::vector<double>>(script.Annotate(*performed).slider);
   SimTake annotation(
       config, [](double) { return sim::RestingTableTProxy(); },
       [slider, frame_at](double t) { return (*slider)[frame_at(t)]; });
