@@ -28,14 +28,11 @@ namespace mmh::track {
 struct MotionOptions {
   // false: constant velocity (persistence 1).
   bool adaptive = true;
-  // Weight of the older steps' sums per frame, in [0, 1): about 1 / (1 - memory) steps count.
-  // Whole Soldier takes, mean within 5 deg and 1 cm over 8 (lowest take): 0.5: 99.67 % (99.0),
-  // 0.75: 99.70 % (99.1), 0.9: 99.61 % (98.6); constant velocity: 99.42 % (98.9).
+  // Weight of the older steps' sums per frame, in [0, 1): about 1 / (1 - memory) steps count
+  // (docs/tracker.md, "How the options were chosen").
   double memory = 0.75;
   // The persistence's ramp over the factor f: 0 at or below stop_below, 1 at or above
-  // continue_above, linear between (equal: a step at that value). Whole Soldier takes (mean of 8,
-  // lowest): [0, 1]: 99.71 % (99.1) but the fast tumbling take 98.5 %; [0.25, 0.75]: 99.70 %
-  // (99.1), tumbling 99.5 %; a step at 0.5: 99.65 % (98.8); [0.1, 0.6]: 99.59 % (98.9).
+  // continue_above, linear between (equal: a step at that value).
   double stop_below = 0.25;
   double continue_above = 0.75;
 

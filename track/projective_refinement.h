@@ -29,8 +29,8 @@ struct ProjectiveOptions {
   // [m] (the noise along the ray, sigma about 2.7 mm at 1.2 m with the disparity lattice and more
   // at grazing incidence, plus the sample's offset within its pixel) or farther than max_residual
   // from the sample's plane [m] (it measured another surface: beside a depth edge the front-most
-  // neighbouring sample can be the occluder's). Rejecting at 6 mm from the sample instead cut the
-  // noise's tail on oblique faces: the Soldier's median translation was 0.85 mm instead of 0.71.
+  // neighbouring sample can be the occluder's). max_distance is wider than max_residual: a tight
+  // cut along the ray trims the noise's tail on oblique faces and biases the fit.
   double max_distance = 0.015;
   double max_residual = 0.006;
   // Huber threshold on the point-to-plane residual [m].

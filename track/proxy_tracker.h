@@ -65,10 +65,9 @@ struct DetectionOptions {
   bool light_rechecks = true;
   double switch_margin = 0.05;
   // ... and far_switch_margin higher when it is more than 45 deg from the tracked pose (a verified
-  // pose does not turn that far in a frame: such a switch is to a twin, or from one). 0.3 (was
-  // 0.15): with the slide check and the twin evidence deciding trusted switches, Soldier whole
-  // takes 1:0 and 4:0 went from 95.3 to 97.4 and 98.0 % (within the detection, continuity now
-  // outweighs a twin's lead of up to 0.3, the skin evidence's cap).
+  // pose does not turn that far in a frame: such a switch is to a twin, or from one). Continuity
+  // outweighs a twin's lead of up to 0.3, the skin evidence's cap; the slide check and the twin
+  // evidence decide trusted switches.
   double far_switch_margin = 0.3;
   // ... and within the detection, a candidate more than 45 deg from another wins over the one
   // nearer the prediction only when it scores far_switch_margin higher, once the track has been
