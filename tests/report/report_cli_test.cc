@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "core/tum_io.h"
@@ -180,6 +183,124 @@ TEST(ReportCli, RunFolderInTheBrowser) {
   ExpectScrubbedPoses(check, montage);
 }
 
+// RFC 4180 lines (the test's own reader: quoted fields may hold commas and doubled quotes).
+std::vector<std::vector<std::string>> CsvRows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::vector<std::string> row(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted && c == '"' && i + 1 < text.size() && text[i + 1] == '"') {
+      row.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (!quoted && c == ',') {
+      row.emplace_back();
+    } else if (!quoted && c == '\n') {
+      rows.push_back(row);
+      row.assign(1, "");
+    } else {
+      row.back() += c;
+    }
+  }
+  return rows;
+}
+
+// A sweep of compose with one injected failure, after `mmh sweep aggregate`: the page's counts,
+// tables and plots against the sweep's files, recomputed here from results.csv.
+TEST(ReportCli, SweepFolderInTheBrowser) {
+  TempDir dir;
+  const auto spec = dir / "spec.json";
+  WriteText(spec, nlohmann::json{
+      {"command", "compose"},
+      {"inputs", {{"takes", {kExample + "take_1.tum", kExample + "take_2.tum", kExample + "take_3.tum"}},
+                  {"annotations", {kExample + "take_1.csv", kExample + "take_2.csv", kExample + "take_3.csv"}}}},
+      {"axes", {{{"key", "montage.labelling.mu"}, {"log", {{"from", 10}, {"to", 1000}, {"count", 3}}}},
+                {{"key", "montage.labelling.min_segment_length"}, {"values", {0, 60}}}}},
+      {"metrics", {{{"name", "total_cost"}, {"file", "summary.json"}, {"key", "total_cost"}},
+                   {{"name", "segments"}, {"file", "summary.json"}, {"key", "segments"}}}}}.dump());
+  const auto out = dir / "sweep";
+  auto r = RunMmh("sweep --dry-run --quiet --spec " + spec.string() + " --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json plan = nlohmann::json::parse(ReadBytes(out / "plan.json"));
+  const std::string failing = plan["cells"][1]["id"];  // mu = 10, d = 60
+  setenv("MMH_SWEEP_FAULT", ("fail:" + failing).c_str(), 1);
+  r = RunMmh("sweep --quiet --jobs 2 --spec " + spec.string() + " --out " + out.string());
+  unsetenv("MMH_SWEEP_FAULT");
+  ASSERT_EQ(r.exit_code, 1) << r.output;
+  r = RunMmh("sweep aggregate " + out.string());
+  ASSERT_EQ(r.exit_code, 1) << r.output;  // the tables are written; 1 says a cell failed
+  ASSERT_NE(r.output.find("5 cells complete, 1 failed"), std::string::npos) << r.output;
+  r = RunMmh("report " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json check = BrowserCheck(out / "report.html", {}, dir / "sweep.png");
+  ExpectCleanLoad(check);
+  EXPECT_EQ(check["kind"], "sweep");
+  EXPECT_FALSE(check["has_view"].get<bool>());
+  const nlohmann::json& page = check["page"];
+  EXPECT_EQ(page["cells"], (nlohmann::json{{"done", 5}, {"failed", 1}, {"missing", 0}}));
+
+  // Every aggregate table on the page as in its file.
+  for (const char* file : {"results.csv", "summary.csv", "failures.csv", "variance_shares.csv"}) {
+    SCOPED_TRACE(file);
+    const auto rows = CsvRows(ReadBytes(out / file));
+    const auto table = std::find_if(page["tables"].begin(), page["tables"].end(),
+                                    [&](const nlohmann::json& t) { return t["caption"] == file; });
+    ASSERT_NE(table, page["tables"].end());
+    EXPECT_EQ((*table)["columns"].get<std::vector<std::string>>(), rows.front());
+    EXPECT_EQ((*table)["rows"].get<std::vector<std::vector<std::string>>>(),
+              std::vector<std::vector<std::string>>(rows.begin() + 1, rows.end()));
+  }
+  EXPECT_NE(ReadBytes(out / "failures.csv").find(failing), std::string::npos);
+
+  // Each metric against each axis: means over the other axis and the t interval (R's qt(0.975,
+  // df)), from results.csv.
+  const double kT975[] = {0, 12.7062047361746941, 4.3026527297494619};
+  const auto results = CsvRows(ReadBytes(out / "results.csv"));
+  const auto column = [&](const std::string& name) {
+    return std::find(results[0].begin(), results[0].end(), name) - results[0].begin();
+  };
+  ASSERT_EQ(page["plots"].size(), 4u);
+  for (const auto& plot : page["plots"]) {
+    const auto x_column = column(plot["axis"]), y_column = column(plot["metric"]);
+    SCOPED_TRACE(plot.dump());
+    std::map<double, std::vector<double>> groups;
+    for (std::size_t i = 1; i < results.size(); ++i) {
+      groups[std::stod(results[i][x_column])].push_back(std::stod(results[i][y_column]));
+    }
+    ASSERT_EQ(plot["points"].size(), groups.size());
+    std::size_t p = 0;
+    for (const auto& [x, ys] : groups) {
+      const auto& point = plot["points"][p++];
+      double mean = 0, ss = 0;
+      for (double y : ys) mean += y / ys.size();
+      for (double y : ys) ss += (y - mean) * (y - mean);
+      EXPECT_DOUBLE_EQ(point[0].get<double>(), x);
+      EXPECT_NEAR(point[1].get<double>(), mean, 1e-9 * (1 + std::abs(mean)));
+      if (ys.size() < 2) {
+        EXPECT_TRUE(point[2].is_null() && point[3].is_null());
+        continue;
+      }
+      const double half = kT975[ys.size() - 1] * std::sqrt(ss / (ys.size() - 1) / ys.size());
+      EXPECT_NEAR(point[2].get<double>(), mean - half, 1e-9 * (1 + std::abs(mean) + half));
+      EXPECT_NEAR(point[3].get<double>(), mean + half, 1e-9 * (1 + std::abs(mean) + half));
+    }
+  }
+  // The aggregate's heat maps and variance shares, inlined.
+  EXPECT_EQ(page["figures"].get<int>(), 3);
+  EXPECT_GT(std::filesystem::file_size(dir / "sweep.png"), 10000u);
+
+  // Before aggregation (no summary.csv): exit 2 naming the file and the command to run.
+  std::filesystem::remove(out / "summary.csv");
+  std::filesystem::remove(out / "report.html");
+  r = RunMmh("report " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("summary.csv"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("mmh sweep aggregate"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "report.html"));
+}
+
 TEST(ReportCli, StudyFolderInTheBrowser) {
   TempDir dir;
   const auto out = dir / "study";
@@ -196,6 +317,25 @@ TEST(ReportCli, StudyFolderInTheBrowser) {
   ExpectCleanLoad(check);
   EXPECT_EQ(check["kind"], "study");
   EXPECT_FALSE(check["has_view"].get<bool>());
+
+  // mmh stats on the study's data: its tables on the page as in the files.
+  const auto stats = dir / "stats";
+  r = RunMmh("stats --quiet --input " + out.string() + " --out " + stats.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = RunMmh("report " + stats.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json stats_check = BrowserCheck(stats / "report.html", {});
+  ExpectCleanLoad(stats_check);
+  EXPECT_EQ(stats_check["kind"], "stats");
+  for (const char* file : {"tests.csv", "take_scores.csv", "animator_scores.csv"}) {
+    const auto rows = CsvRows(ReadBytes(stats / file));
+    const auto& tables = stats_check["page"]["tables"];
+    const auto table = std::find_if(tables.begin(), tables.end(),
+                                    [&](const nlohmann::json& t) { return t["caption"] == file; });
+    ASSERT_NE(table, tables.end()) << file;
+    EXPECT_EQ((*table)["rows"].size() + 1, rows.size()) << file;
+    EXPECT_EQ((*table)["rows"].back().get<std::vector<std::string>>(), rows.back()) << file;
+  }
 }
 
 // Takes given relative to where mmh compose ran are found from any working directory (run.json's
@@ -224,6 +364,9 @@ TEST(ReportCli, BadFoldersExitTwoAndWriteNothing) {
   auto r = RunMmh("report " + (dir / "other").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("expected the output of mmh compose"), std::string::npos) << r.output;
+  for (const char* kind : {"mmh run", "mmh study", "mmh stats", "mmh sweep", "plan.json"}) {
+    EXPECT_NE(r.output.find(kind), std::string::npos) << kind << ": " << r.output;
+  }
   EXPECT_FALSE(std::filesystem::exists(dir / "other" / "report.html"));
 
   // compose with a model that cannot be read: nothing written.

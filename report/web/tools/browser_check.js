@@ -2,7 +2,8 @@
 // prints what the browser test checks, as JSON: console errors and uncaught exceptions, network
 // requests other than the file itself, the 3D canvas's non-background pixels, the montage node's
 // pose after moving the scrubber to each requested frame, the cost of a scrub step and the frame
-// rate while playing; optionally a full-page screenshot.
+// rate while playing; the page's tables, plots and counts read back from its DOM; optionally a
+// full-page screenshot.
 //   node --experimental-websocket browser_check.js --chromium PATH --html FILE
 //        [--frames 0,10,...] [--screenshot OUT.png] [--timeout-ms 60000]
 // Exit 0 when the page loaded (the checks are the caller's), 2 on a usage or browser error.
@@ -123,6 +124,8 @@ async function check(args) {
     result.page_errors = await evaluate('window.mmhReport ? window.mmhReport.errors : ["no mmhReport"]');
     result.kind = await evaluate('window.mmhReport && window.mmhReport.data.kind');
     result.has_view = await evaluate('!!(window.mmhReport && window.mmhReport.view)');
+    // What the page shows, read back from its DOM (tables, plots, cell counts).
+    if (result.ready) result.page = await evaluate('mmhReport.inspect()');
     if (result.ready && result.has_view) {
       result.montage_frames = await evaluate('mmhReport.view.times.length');
       result.pixels = await evaluate('mmhReport.view.foregroundPixels()');
