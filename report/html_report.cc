@@ -13,6 +13,8 @@
 #include "core/text_parsing.h"
 #include "core/tum_io.h"
 #include "montage/match_cost.h"
+#include "montage/blend.h"
+#include "report/montage_clock.h"
 #include "report/report_bundle.h"
 #include "report/report_tables.h"
 #include "report/sweep_data.h"
@@ -164,6 +166,7 @@ json MontageData(const MontageFolder& folder, const ReportOptions& options, std:
   }
   const fs::path segments_path = dir / "segments.csv";
   const CsvTable segments = ReadCsvTable(segments_path);
+  std::vector<montage::MontageSegment> played;
   for (std::size_t r = 0; r < segments.rows.size(); ++r) {
     json s;
     for (const char* key : {"take", "reference_first", "reference_last", "source_first",
@@ -171,8 +174,22 @@ json MontageData(const MontageFolder& folder, const ReportOptions& options, std:
       s[key] = static_cast<int>(NumberAt(segments, r, ColumnOf(segments, key, segments_path),
                                          segments_path));
     }
+    played.push_back({s["take"], s["reference_first"], s["reference_last"], s["source_first"],
+                      s["source_last"], s["montage_first"], s["montage_last"]});
     data["segments"].push_back(s);
   }
+  // Every take at its own frame for each montage frame (the 3D view's clocks).
+  MontageClock clock;
+  try {
+    clock = ComputeMontageClock(played, warps);
+  } catch (const InputError& e) {
+    ThrowBadValue(segments_path.string(), e.what(), "the segments mmh wrote with timeline.csv");
+  }
+  if (clock.reference.size() != montage.size()) {
+    ThrowBadValue(segments_path.string(), std::to_string(clock.reference.size()) + " montage frames",
+                  std::to_string(montage.size()) + " (the frames of montage.tum)");
+  }
+  data["clock"] = {{"reference", clock.reference}, {"takes", clock.takes}};
   const json summary = ReadJsonFile(dir / "summary.json");
   std::vector<double> dtw_costs(m, std::nan(""));
   if (summary.contains("dtw_costs") && summary["dtw_costs"].size() == m) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "core/tum_io.h"
@@ -66,30 +67,96 @@ void ExpectCleanLoad(const nlohmann::json& check) {
   EXPECT_TRUE(check["requests"].empty()) << check["requests"].dump(1);
 }
 
+// A node's local pose read from the page (glTF axes, 32-bit floats) is gltf_T_table * pose.
+void ExpectNodePose(const nlohmann::json& node, const Rigid3& table_T_proxy, const std::string& what) {
+  const Rigid3 expected = report::GltfTFrame(report::TrajectoryFrame::kTable) * table_T_proxy;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(node["position"][c].get<double>(), expected.translation(c), 1e-6) << what;
+  }
+  const Eigen::Vector4d q(node["quaternion"][0], node["quaternion"][1], node["quaternion"][2],
+                          node["quaternion"][3]);
+  const Eigen::Vector4d e = expected.rotation.coeffs();
+  EXPECT_LE(std::min((q - e).cwiseAbs().maxCoeff(), (q + e).cwiseAbs().maxCoeff()), 1e-6) << what;
+}
+
 // The montage node at each checked frame is the montage's pose there (glTF axes, 32-bit floats).
 void ExpectScrubbedPoses(const nlohmann::json& check, const Trajectory& table_T_proxy) {
   ASSERT_TRUE(check["has_view"].get<bool>());
   EXPECT_EQ(check["montage_frames"].get<std::size_t>(), table_T_proxy.size());
   EXPECT_GT(check["pixels"]["count"].get<int>(), 1000) << check["pixels"].dump();
-  const Rigid3 gltf_T_table = report::GltfTFrame(report::TrajectoryFrame::kTable);
   ASSERT_FALSE(check["poses"].empty());
   for (const auto& pose : check["poses"]) {
     const int k = pose["frame"];
-    const Rigid3 expected = gltf_T_table * table_T_proxy.poses[k];
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_NEAR(pose["position"][c].get<double>(), expected.translation(c), 1e-6) << "frame " << k;
-    }
-    const Eigen::Vector4d q(pose["quaternion"][0], pose["quaternion"][1], pose["quaternion"][2],
-                            pose["quaternion"][3]);
-    const Eigen::Vector4d e = expected.rotation.coeffs();
-    EXPECT_LE(std::min((q - e).cwiseAbs().maxCoeff(), (q + e).cwiseAbs().maxCoeff()), 1e-6)
-        << "frame " << k;
+    ExpectNodePose(pose, table_T_proxy.poses[k], "montage frame " + std::to_string(k));
   }
   std::printf("[ browser  ] %d montage frames, %d non-background pixels, scrub step %.2f ms, "
               "playing at %.1f frames/s, loaded in %d ms\n",
               check["montage_frames"].get<int>(), check["pixels"]["count"].get<int>(),
               check["scrub_ms"].get<double>(), check["playback_fps"].get<double>(),
               check["load_ms"].get<int>());
+}
+
+// The montage played as the paper unwarps it, by brute force over timeline.csv (reference frame,
+// chosen take, warp_K): a run of reference frames of one take plays its source frames
+// w(t - 1) + 1 .. w(t) at each t, the run's first t from w(t). Per montage frame: the reference
+// frame it was played from, the take and its source frame.
+struct Played {
+  std::vector<int> reference, take, source;
+  std::vector<std::vector<int>> warps;  // [take][reference frame]
+};
+Played PlayTimeline(const std::filesystem::path& timeline_csv) {
+  Played played;
+  std::vector<int> labels;
+  std::istringstream lines(ReadBytes(timeline_csv));
+  std::string line;
+  std::getline(lines, line);
+  const std::size_t takes = (std::count(line.begin(), line.end(), ',') - 1) / 2;
+  played.warps.resize(takes);
+  while (std::getline(lines, line)) {
+    std::istringstream fields(line);
+    std::string field;
+    std::vector<int> row;
+    while (std::getline(fields, field, ',') && row.size() < 2 + takes) row.push_back(std::stoi(field));
+    labels.push_back(row[1]);
+    for (std::size_t l = 0; l < takes; ++l) played.warps[l].push_back(row[2 + l]);
+  }
+  for (std::size_t t = 0; t < labels.size(); ++t) {
+    const int l = labels[t];
+    const int from = t > 0 && labels[t - 1] == l ? played.warps[l][t - 1] + 1 : played.warps[l][t];
+    for (int j = from; j <= played.warps[l][t]; ++j) {
+      played.reference.push_back(static_cast<int>(t));
+      played.take.push_back(l);
+      played.source.push_back(j);
+    }
+  }
+  return played;
+}
+
+// At each scrubbed montage frame k (played from reference frame t), take K's warped node shows
+// T_K(w_K(t)) and its recorded node T_K at its own frame: w_K(t), or for the take the montage plays
+// at k, the very source frame played.
+void ExpectTakesInSync(const nlohmann::json& check, const std::vector<Trajectory>& takes,
+                       const std::filesystem::path& timeline_csv) {
+  const Played played = PlayTimeline(timeline_csv);
+  ASSERT_EQ(played.reference.size(), check["montage_frames"].get<std::size_t>());
+  ASSERT_EQ(played.warps.size(), takes.size());
+  int checked = 0;
+  for (const auto& pose : check["poses"]) {
+    const int k = pose["frame"], t = played.reference[k];
+    for (std::size_t K = 0; K < takes.size(); ++K) {
+      const std::string take = "proxy_take_" + std::to_string(K + 1);
+      const int own = static_cast<int>(K) == played.take[k] ? played.source[k] : played.warps[K][t];
+      const std::string at = " at montage frame " + std::to_string(k) + " (reference " +
+                             std::to_string(t) + ")";
+      ASSERT_TRUE(pose["nodes"].contains(take + "_warped")) << pose["nodes"].dump();
+      ExpectNodePose(pose["nodes"][take + "_warped"], takes[K].poses[played.warps[K][t]],
+                     take + " warped" + at);
+      ExpectNodePose(pose["nodes"][take + "_recorded"], takes[K].poses[own],
+                     take + " recorded (frame " + std::to_string(own) + ")" + at);
+      checked += own != k;  // a frame other than the montage's own clock
+    }
+  }
+  EXPECT_GT(checked, 0);
 }
 
 TEST(ExportCli, TumAndModelToGlb) {
@@ -162,6 +229,8 @@ TEST(ReportCli, ComposeFolderInTheBrowser) {
   ExpectCleanLoad(check);
   EXPECT_EQ(check["kind"], "compose");
   ExpectScrubbedPoses(check, montage);
+  ExpectTakesInSync(check, {ReadTum(kExample + "take_1.tum"), ReadTum(kExample + "take_2.tum"),
+                            ReadTum(kExample + "take_3.tum")}, out / "timeline.csv");
   EXPECT_GT(std::filesystem::file_size(dir / "compose.png"), 10000u);
 }
 
@@ -176,11 +245,14 @@ TEST(ReportCli, RunFolderInTheBrowser) {
   r = RunMmh("report --quiet " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Trajectory montage = ReadTum(out / "montage" / "montage.tum");
-  const nlohmann::json check =
-      BrowserCheck(out / "report.html", {0, static_cast<int>(montage.size()) - 1});
+  const int last = static_cast<int>(montage.size()) - 1;
+  const nlohmann::json check = BrowserCheck(out / "report.html", {0, last / 2, last});
   ExpectCleanLoad(check);
   EXPECT_EQ(check["kind"], "run");
   ExpectScrubbedPoses(check, montage);
+  ExpectTakesInSync(check, {ReadTum(out / "takes" / "take_0" / "tracked.tum"),
+                            ReadTum(out / "takes" / "take_1" / "tracked.tum")},
+                    out / "montage" / "timeline.csv");
 }
 
 // RFC 4180 lines (the test's own reader: quoted fields may hold commas and doubled quotes).

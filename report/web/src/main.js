@@ -56,7 +56,8 @@ async function main() {
     app.append(scrubberHost);
     const listeners = [];
     if (glbElement) {
-      api.view = new View3d(scrubberHost, data.montage, (frame) => listeners.forEach((f) => f(frame)));
+      api.view = new View3d(scrubberHost, data.montage, data.clock,
+        (frame, t) => listeners.forEach((f) => f(frame, t)));
       await api.view.load(decodeBase64(glbElement.textContent).buffer);
     }
     app.append(segmentSection(data, listeners));
