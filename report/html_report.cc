@@ -268,6 +268,24 @@ json ComposeData(const fs::path& dir, const ReportOptions& options, std::string*
   }
   json data = MontageData(folder, options, glb);
   data["title"] = "Montage of " + std::to_string(folder.takes.size()) + " takes";
+  // Layered objects (mmh compose --layer-takes): composed without time warping, each in
+  // layers/NAME/; the 3D view plays them beside the first object.
+  if (summary.contains("layers")) {
+    for (const json& layer : summary["layers"]) {
+      const std::string name = layer.value("name", "");
+      const fs::path layer_dir = dir / "layers" / name;
+      const json layer_summary = ReadJsonFile(layer_dir / "summary.json");
+      data["tables"].push_back(TableJson(
+          "Layered object " + name + ": segments", layer_dir / "segments.csv",
+          std::to_string(layer_summary.value("takes", 0)) + " takes composed without time "
+          "warping; total cost " + layer_summary.value("total_cost", json()).dump() +
+          (layer_summary.contains("warnings") && !layer_summary["warnings"].empty()
+               ? "; warnings: " + layer_summary["warnings"].dump()
+               : "")));
+    }
+    data["title"] = data["title"].get<std::string>() + " and " +
+                    std::to_string(summary["layers"].size()) + " layered objects";
+  }
   return data;
 }
 

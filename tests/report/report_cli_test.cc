@@ -13,6 +13,7 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "core/tum_io.h"
 #include "report/gltf_scene.h"
 #include "tests/report/glb_test_util.h"
@@ -208,16 +209,44 @@ TEST(ExportCli, BadInputExitsTwoAndWritesNothing) {
   EXPECT_TRUE(std::filesystem::is_empty(out));
 }
 
+// A layered object (paper, "Creating montages for more than one object") recorded while the first
+// object's montage played: two takes of the montage's length, offset from it.
+void WriteLayerTakes(const Trajectory& montage, const std::filesystem::path& dir) {
+  for (int k = 1; k <= 2; ++k) {
+    Trajectory take = montage;
+    std::string csv = "timestamp,value\n";
+    for (std::size_t i = 0; i < take.size(); ++i) {
+      take.poses[i].translation += Eigen::Vector3d(0.1 * k, 0.05 * k, 0.01 * std::sin(0.05 * i));
+      csv += FormatNumber(take.timestamps[i]) + "," +
+             FormatNumber(3.0 * std::sin(0.01 * (k == 1 ? 1.0 : -1.0) * static_cast<double>(i))) + "\n";
+    }
+    WriteTum(dir / ("layer_" + std::to_string(k) + ".tum"), take, "layered take");
+    WriteText(dir / ("layer_" + std::to_string(k) + ".csv"), csv);
+  }
+}
+
 TEST(ReportCli, ComposeFolderInTheBrowser) {
   TempDir dir;
-  const auto out = dir / "compose";
-  auto r = RunMmh(Compose(out, "--markers 100 400 --model " + kSource + "/configs/proxies/soldier.json"));
+  auto r = RunMmh(Compose(dir / "base", "--no-glb"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  WriteLayerTakes(ReadTum(dir / "base" / "montage.tum"), dir.path());
+  const auto out = dir / "compose";
+  const std::string layer = dir.path().string() + "/layer_";
+  r = RunMmh(Compose(out, "--markers 100 400 --model " + kSource + "/configs/proxies/soldier.json" +
+                              " --layer-takes " + layer + "1.tum " + layer + "2.tum" +
+                              " --layer-annotations " + layer + "1.csv " + layer + "2.csv" +
+                              " --layer-names cube"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The first object's montage is the one composed alone; the layer has its own folder.
+  EXPECT_EQ(ReadBytes(out / "montage.tum"), ReadBytes(dir / "base" / "montage.tum"));
+  const Trajectory cube = ReadTum(out / "layers" / "cube" / "montage.tum");
+  ASSERT_EQ(cube.size(), ReadTum(out / "montage.tum").size());
   test_util::ExpectValidGltf({out / "montage.glb"});
   r = RunMmh("report " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string html = ReadBytes(out / "report.html");
   EXPECT_LT(html.size(), 5u << 20);
+  EXPECT_NE(html.find("Layered object cube"), std::string::npos);
   // Self-contained: no external script, style or image.
   for (const char* external : {"<script src", "<link", "<img src=\"http", "@import"}) {
     EXPECT_EQ(html.find(external), std::string::npos) << external;
@@ -231,6 +260,18 @@ TEST(ReportCli, ComposeFolderInTheBrowser) {
   ExpectScrubbedPoses(check, montage);
   ExpectTakesInSync(check, {ReadTum(kExample + "take_1.tum"), ReadTum(kExample + "take_2.tum"),
                             ReadTum(kExample + "take_3.tum")}, out / "timeline.csv");
+  // The layered object plays with the montage, frame for frame (no time warp).
+  const std::vector<Trajectory> layer_takes = {ReadTum(layer + "1.tum"), ReadTum(layer + "2.tum")};
+  for (const auto& pose : check["poses"]) {
+    const int k = pose["frame"];
+    const std::string at = " at montage frame " + std::to_string(k);
+    ExpectNodePose(pose["nodes"]["cube_montage"], cube.poses[k], "cube montage" + at);
+    for (int K = 0; K < 2; ++K) {
+      const std::string take = "cube_take_" + std::to_string(K + 1);
+      ExpectNodePose(pose["nodes"][take + "_warped"], layer_takes[K].poses[k], take + at);
+      ExpectNodePose(pose["nodes"][take + "_recorded"], layer_takes[K].poses[k], take + at);
+    }
+  }
   EXPECT_GT(std::filesystem::file_size(dir / "compose.png"), 10000u);
 }
 
@@ -427,6 +468,39 @@ TEST(ReportCli, RelativeTakesFromAnotherDirectory) {
   const std::string html = ReadBytes(dir / "out" / "report.html");
   EXPECT_NE(html.find("\"take_2\""), std::string::npos);
   EXPECT_EQ(html.find("id=\"mmh-glb\""), std::string::npos);  // --no-glb: no 3D view
+}
+
+TEST(ComposeCli, BadLayersExitTwoAndWriteNothing) {
+  TempDir dir;
+  WriteLayerTakes(ReadTum(kExample + "take_1.tum"), dir.path());
+  const std::string l = dir.path().string() + "/layer_";
+  WriteText(dir / "short.tum", "0 0 0 0 0 0 0 1\n0.033 0 0 0 0 0 0 1\n");
+  WriteText(dir / "short.csv", "timestamp,value\n0,1\n0.033,1\n");
+  struct Case {
+    std::string arguments, expected;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--layer-takes " + l + "1.tum " + l + "2.tum", "--layer-annotations"},
+           {"--layer-takes " + l + "1.tum " + l + "2.tum --layer-annotations " + l + "1.csv",
+            "1 files for 2 takes"},
+           {"--layer-takes " + l + "1.tum " + l + "2.tum --layer-annotations " + l + "1.csv " + l +
+                "2.csv --layer-names 'a b'",
+            "'a b'"},
+           {"--layer-takes " + l + "1.tum " + l + "2.tum --layer-annotations " + l + "1.csv " + l +
+                "2.csv --layer-names proxy",
+            "other than 'proxy'"},
+           {"--layer-takes " + l + "1.tum " + (dir / "short.tum").string() + " --layer-annotations " +
+                l + "1.csv " + (dir / "short.csv").string(),
+            "short.tum"},
+           {"--layer-takes " + l + "1.tum " + l + "2.tum --layer-annotations " + l + "1.csv " + l +
+                "2.csv --layer-models " + (dir / "missing.ply").string(),
+            "missing.ply"},
+       }) {
+    const auto r = RunMmh(Compose(dir / "out", c.arguments));
+    EXPECT_EQ(r.exit_code, 2) << c.arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.expected << "\n" << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  }
 }
 
 TEST(ReportCli, BadFoldersExitTwoAndWriteNothing) {

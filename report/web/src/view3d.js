@@ -84,6 +84,10 @@ export class View3d {
           byNode.get(node).push(track);
         }
         const name = THREE.PropertyBinding.sanitizeNodeName(this.montage.node);
+        // The clocks are the first object's; layered objects were recorded while its montage
+        // played (no time warp): their nodes show frame k of their own tracks.
+        const object = name.slice(0, -'_montage'.length);
+        const ofObject = new RegExp(`^${object}_take_(\\d+)_(warped|recorded)$`);
         this.clocks = [];
         for (const [node, tracks] of byNode) {
           const action = this.mixer.clipAction(new THREE.AnimationClip(node, -1, tracks));
@@ -91,10 +95,10 @@ export class View3d {
           action.setLoop(THREE.LoopOnce, 1);
           action.clampWhenFinished = true;
           action.play();
-          const take = node.match(/_take_(\d+)_(warped|recorded)$/);
+          const take = node.match(ofObject);
           this.clocks.push({
             node, action, times: tracks[0].times,
-            role: take ? take[2] : 'montage', take: take ? Number(take[1]) - 1 : -1,
+            role: take ? take[2] : node === name ? 'montage' : 'layer', take: take ? Number(take[1]) - 1 : -1,
           });
         }
         this.node = this.root.getObjectByName(name);
