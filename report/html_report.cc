@@ -284,7 +284,8 @@ json ComposeData(const fs::path& dir, const ReportOptions& options, std::string*
                : "")));
     }
     data["title"] = data["title"].get<std::string>() + " and " +
-                    std::to_string(summary["layers"].size()) + " layered objects";
+                    std::to_string(summary["layers"].size()) +
+                    (summary["layers"].size() == 1 ? " layered object" : " layered objects");
   }
   return data;
 }

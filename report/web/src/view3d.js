@@ -204,15 +204,21 @@ export class View3d {
     return { count, total: w * h };
   }
 
-  // Scrubbing cost: mean milliseconds to move to a frame and draw it (finished on the GPU).
+  // Scrubbing cost: milliseconds to move to a frame and draw it (finished on the GPU), over
+  // `steps` frames spread over the montage: {mean, median, p95, max}.
   scrubMilliseconds(steps) {
     const gl = this.renderer.getContext();
     const probe = new Uint8Array(4);
-    const t0 = performance.now();
+    const times = [];
     for (let i = 0; i < steps; ++i) {
+      const t0 = performance.now();
       this.showFrame(Math.floor((i * (this.times.length - 1)) / Math.max(1, steps - 1)));
       gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, probe);
+      times.push(performance.now() - t0);
     }
-    return (performance.now() - t0) / steps;
+    const sorted = times.slice().sort((a, b) => a - b);
+    const at = (q) => sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))];
+    return { mean: times.reduce((a, b) => a + b, 0) / steps, median: at(0.5), p95: at(0.95),
+      max: sorted[sorted.length - 1] };
   }
 }

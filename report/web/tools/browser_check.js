@@ -6,6 +6,7 @@
 // full-page screenshot.
 //   node --experimental-websocket browser_check.js --chromium PATH --html FILE
 //        [--frames 0,10,...] [--screenshot OUT.png] [--timeout-ms 60000]
+//        [--scrub-steps 60] [--play-seconds 1]   (the scrubbing measurement, bench/README.md)
 // Exit 0 when the page loaded (the checks are the caller's), 2 on a usage or browser error.
 'use strict';
 const { spawn } = require('child_process');
@@ -14,7 +15,7 @@ const os = require('os');
 const path = require('path');
 
 function parseArgs(argv) {
-  const args = { frames: [], timeoutMs: 60000 };
+  const args = { frames: [], timeoutMs: 60000, scrubSteps: 60, playSeconds: 1 };
   for (let i = 0; i < argv.length; i += 2) {
     const [key, value] = [argv[i], argv[i + 1]];
     if (key === '--chromium') args.chromium = value;
@@ -22,6 +23,8 @@ function parseArgs(argv) {
     else if (key === '--frames') args.frames = value.split(',').filter((s) => s).map(Number);
     else if (key === '--screenshot') args.screenshot = value;
     else if (key === '--timeout-ms') args.timeoutMs = Number(value);
+    else if (key === '--scrub-steps') args.scrubSteps = Number(value);
+    else if (key === '--play-seconds') args.playSeconds = Number(value);
     else throw new Error(`unknown argument ${key}`);
   }
   if (!args.chromium || !args.html) throw new Error('--chromium and --html are required');
@@ -137,12 +140,13 @@ async function check(args) {
           return mmhReport.view.montagePose(); })()`);
         result.poses.push({ frame, ...pose });
       }
-      result.scrub_ms = await evaluate('mmhReport.view.scrubMilliseconds(60)');
-      // Frame rate while playing: requestAnimationFrame callbacks per second over one second.
+      result.scrub = await evaluate(`mmhReport.view.scrubMilliseconds(${args.scrubSteps})`);
+      result.scrub_ms = result.scrub.mean;
+      // Frame rate while playing: requestAnimationFrame callbacks per second over --play-seconds.
       result.playback_fps = await evaluate(`new Promise((resolve) => {
         mmhReport.view.showFrame(0); mmhReport.view.toggle();
         let n = 0; const t0 = performance.now();
-        const f = () => { ++n; if (performance.now() - t0 < 1000) requestAnimationFrame(f);
+        const f = () => { ++n; if (performance.now() - t0 < ${1000 * args.playSeconds}) requestAnimationFrame(f);
           else { if (mmhReport.view.playing) mmhReport.view.toggle();
                  resolve(n / ((performance.now() - t0) / 1000)); } };
         requestAnimationFrame(f); })`);
