@@ -404,6 +404,23 @@ TEST(ReportCli, SweepFolderInTheBrowser) {
   EXPECT_EQ(page["figures"].get<int>(), 3);
   EXPECT_GT(std::filesystem::file_size(dir / "sweep.png"), 10000u);
 
+  // A cell removed after the aggregation: the page says the tables are older than the cells.
+  std::filesystem::remove_all(out / "cells" / plan["cells"][0]["id"].get<std::string>());
+  r = RunMmh("report " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(ReadBytes(out / "report.html").find("\"aggregate_current\":false"), std::string::npos);
+  EXPECT_NE(ReadBytes(out / "report.html").find("\"missing\":1"), std::string::npos);
+
+  // results.csv naming a cell the plan does not have: exit 2 naming the file and line.
+  const std::string text = ReadBytes(out / "results.csv");
+  WriteText(out / "results.csv", text.substr(0, text.find('\n') + 1) + "0123456789abcdef" +
+                                     text.substr(text.find(',', text.find('\n'))));
+  std::filesystem::remove(out / "report.html");
+  r = RunMmh("report " + out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("results.csv:2 cell"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "report.html"));
+
   // Before aggregation (no summary.csv): exit 2 naming the file and the command to run.
   std::filesystem::remove(out / "summary.csv");
   std::filesystem::remove(out / "report.html");
