@@ -2,10 +2,12 @@
 // three takes: .glb and report written in under 1 s; the report under 5 MB"). Run from a Release
 // build:
 //   build/bench/bench_report --benchmark_counters_tabular=true
+// MMH_BENCH_REPORT_DIR=DIR keeps the folder and its report.html (scrubbing measured in Chromium).
 // Figures and machine are recorded in bench/README.md.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -28,7 +30,12 @@ struct Folder {
   std::vector<mmh::Trajectory> takes;
   mmh::montage::Montage montage;
   Folder() {
-    dir = fs::temp_directory_path() / ("mmh_bench_report_" + std::to_string(::getpid()));
+    // MMH_BENCH_REPORT_DIR keeps the folder (with report.html) for the browser's measurement
+    // (bench/README.md); by default a temporary folder, removed at the end.
+    const char* keep = std::getenv("MMH_BENCH_REPORT_DIR");
+    keep_ = keep && *keep;
+    dir = keep_ ? fs::path(keep)
+                : fs::temp_directory_path() / ("mmh_bench_report_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     mmh::synthetic::TakeSetOptions options;
     options.takes = 3;
@@ -52,7 +59,10 @@ struct Folder {
     mmh::WriteFileAtomically(dir / "timeline.csv", mmh::montage::TimelineToCsv(montage));
     mmh::WriteFileAtomically(dir / "summary.json", summary.dump(2));
   }
-  ~Folder() { fs::remove_all(dir); }
+  ~Folder() {
+    if (!keep_) fs::remove_all(dir);
+  }
+  bool keep_ = false;
 };
 
 Folder& TheFolder() {

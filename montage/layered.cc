@@ -16,12 +16,14 @@ std::vector<Montage> ComposeLayered(const std::vector<LayeredObject>& objects,
     ComposeOptions object_options = options;
     // Later objects were recorded while the earlier montages played: equal lengths, no warp.
     if (i > 0) object_options.time_warp = false;
-    std::vector<std::string> names;
-    for (std::size_t k = 0; k < object.takes.size(); ++k) {
-      names.push_back(object.name + " take " + std::to_string(k));
-    }
-    for (std::size_t k = 0; k < object.annotations.size(); ++k) {
-      names.push_back(object.name + " annotation " + std::to_string(k));
+    std::vector<std::string> names = object.names;
+    if (names.empty()) {
+      for (std::size_t k = 0; k < object.takes.size(); ++k) {
+        names.push_back(object.name + " take " + std::to_string(k));
+      }
+      for (std::size_t k = 0; k < object.annotations.size(); ++k) {
+        names.push_back(object.name + " annotation " + std::to_string(k));
+      }
     }
     Montage montage = Compose(object.takes, object.annotations, object_options, names);
     if (i > 0 && montage.trajectory.size() != montages[0].trajectory.size()) {

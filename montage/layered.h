@@ -16,6 +16,9 @@ struct LayeredObject {
   std::string name;
   std::vector<Trajectory> takes;
   std::vector<Annotation> annotations;
+  // Names of the takes then the annotations in messages (e.g. their files); empty: "<name> take
+  // K" and "<name> annotation K".
+  std::vector<std::string> names;
 };
 
 // objects[0] with options.time_warp as given; objects[1..] with time_warp = false. Takes of a later

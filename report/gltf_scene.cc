@@ -23,6 +23,8 @@ constexpr std::uint32_t kJsonChunk = 0x4E4F534A;
 constexpr std::uint32_t kBinChunk = 0x004E4942;
 // The grey of spatial markers (the paper's Figure 5 shows the marked poses as grey copies).
 constexpr double kMarkerGrey = 0.45;
+// Largest error of a 32-bit float keyframe time (s) before the exact times go to the extras.
+constexpr double kExactTimeError = 5e-7;
 
 // The binary chunk and the JSON entries describing it, one bufferView per accessor.
 class BufferBuilder {
@@ -256,6 +258,7 @@ std::string EncodeGlb(const GltfScene& scene) {
       const Trajectory& poses = track.parent_T_node;
       out["extras"]["mmh_time_origins_s"][scene.nodes[track.node].name] = track.time_origin;
       std::vector<float> times, translations, rotations;
+      double max_time_error = 0.0;
       Eigen::Quaterniond previous = poses.poses.front().rotation;
       for (std::size_t i = 0; i < poses.size(); ++i) {
         const float time = static_cast<float>(poses.timestamps[i] - track.time_origin);
@@ -267,11 +270,35 @@ std::string EncodeGlb(const GltfScene& scene) {
                             FormatNumber(track.time_origin) + " s");
         }
         times.push_back(time);
+        max_time_error = std::max(max_time_error,
+                                  std::abs(double(time) - (poses.timestamps[i] - track.time_origin)));
         Eigen::Quaterniond q = poses.poses[i].rotation.normalized();
         if (q.coeffs().dot(previous.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
         previous = q;
         for (int c = 0; c < 3; ++c) translations.push_back(static_cast<float>(poses.poses[i].translation(c)));
         for (int c = 0; c < 4; ++c) rotations.push_back(static_cast<float>(q.coeffs()(c)));  // x y z w
+      }
+      // The input accessor must be 32-bit floats (glTF 2.0, "Animations"): half a unit in the last
+      // place is 4.8e-7 s below 16 s, 9.5e-7 s from 16 s on, 3.8e-6 s at 100 s. Beyond 5e-7 s
+      // the exact times go to the extras too: the frame period of an evenly sampled track
+      // (timestamps origin + i * period to 5e-7 s), else every time after the origin (JSON
+      // doubles).
+      if (max_time_error > kExactTimeError) {
+        const std::string& name = scene.nodes[track.node].name;
+        const double period = poses.size() > 1 ? (poses.timestamps.back() - poses.timestamps.front()) /
+                                                     static_cast<double>(poses.size() - 1)
+                                               : 0.0;
+        bool even = poses.size() > 1;
+        for (std::size_t i = 0; i < poses.size() && even; ++i) {
+          even = std::abs(poses.timestamps.front() + double(i) * period - poses.timestamps[i]) <= kExactTimeError;
+        }
+        if (even && poses.timestamps.front() == track.time_origin) {
+          out["extras"]["mmh_frame_periods_s"][name] = period;
+        } else {
+          json exact = json::array();
+          for (double t : poses.timestamps) exact.push_back(t - track.time_origin);
+          out["extras"]["mmh_times_s"][name] = exact;
+        }
       }
       const int input = buffer.AddFloats(times, 1, "SCALAR", false, true);
       const int translation = buffer.AddFloats(translations, 3, "VEC3", false, false);

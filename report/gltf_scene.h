@@ -49,6 +49,11 @@ struct GltfTrack {
   // Subtracted from every timestamp (glTF times start near 0 and are 32-bit floats: a TUM
   // timestamp of 1.3e9 s would lose its frames). Written to the animation's extras
   // ("mmh_time_origins_s": node name -> origin), so that a reader gets the timestamps back.
+  // Where 32-bit float times are off by more than 5e-7 s (from 16 s after the origin on; 1e-6 s
+  // is passed at 16.8 s, 3.8e-6 s at 100 s), the extras also hold the exact times:
+  // "mmh_frame_periods_s" (node -> period: timestamp i = origin + i * period to 5e-7 s, for
+  // evenly sampled tracks starting at the origin) or else "mmh_times_s" (node -> every
+  // timestamp - origin).
   double time_origin = 0.0;
 };
 

@@ -13,7 +13,11 @@
 #include "core/text_parsing.h"
 #include "core/tum_io.h"
 #include "montage/match_cost.h"
+#include "montage/blend.h"
+#include "report/montage_clock.h"
 #include "report/report_bundle.h"
+#include "report/report_tables.h"
+#include "report/sweep_data.h"
 
 namespace mmh::report {
 namespace {
@@ -23,93 +27,6 @@ using nlohmann::json;
 
 // The name of the montage's node in montage.glb (MontageScene names it "<object> montage").
 constexpr char kMontageNode[] = "proxy montage";
-
-// A CSV file as a table of strings (RFC 4180 quoting: "a,b" and "" inside quotes).
-struct CsvTable {
-  std::vector<std::string> columns;
-  std::vector<std::vector<std::string>> rows;
-};
-
-std::vector<std::string> SplitQuotedCsvLine(const std::string& line) {
-  std::vector<std::string> fields(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        fields.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        fields.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.emplace_back();
-    } else if (c != '\r') {
-      fields.back() += c;
-    }
-  }
-  return fields;
-}
-
-CsvTable ReadCsvTable(const fs::path& path) {
-  const std::string text = ReadTextFile(path);
-  CsvTable table;
-  std::size_t start = 0;
-  int line_number = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    const std::string line = text.substr(start, end - start);
-    start = end + 1;
-    ++line_number;
-    if (Trim(line).empty()) continue;
-    std::vector<std::string> fields = SplitQuotedCsvLine(line);
-    if (table.columns.empty()) {
-      table.columns = std::move(fields);
-    } else if (fields.size() != table.columns.size()) {
-      ThrowBadValue(path.string() + ":" + std::to_string(line_number),
-                    std::to_string(fields.size()) + " fields",
-                    std::to_string(table.columns.size()) + " fields as in the header");
-    } else {
-      table.rows.push_back(std::move(fields));
-    }
-  }
-  if (table.columns.empty()) ThrowBadValue(path.string(), "an empty file", "a CSV with a header");
-  return table;
-}
-
-int ColumnOf(const CsvTable& table, const std::string& name, const fs::path& path) {
-  const auto it = std::find(table.columns.begin(), table.columns.end(), name);
-  if (it == table.columns.end()) ThrowBadValue(path.string(), "no column " + name, "mmh's layout");
-  return static_cast<int>(it - table.columns.begin());
-}
-
-double NumberAt(const CsvTable& table, std::size_t row, int column, const fs::path& path) {
-  double value = 0.0;
-  if (!ParseDouble(table.rows[row][column], &value)) {
-    ThrowBadValue(path.string() + ":" + std::to_string(row + 2) + " " + table.columns[column],
-                  table.rows[row][column], "a number");
-  }
-  return value;
-}
-
-json TableJson(const std::string& title, const fs::path& path, const std::string& note = "") {
-  const CsvTable table = ReadCsvTable(path);
-  return {{"title", title}, {"file", path.filename().string()}, {"note", note},
-          {"columns", table.columns}, {"rows", table.rows}};
-}
-
-json ReadJsonFile(const fs::path& path) {
-  try {
-    return json::parse(ReadTextFile(path));
-  } catch (const json::parse_error& e) {
-    ThrowBadValue(path.string(), e.what(), "a JSON file");
-  }
-}
 
 std::string Base64(const std::string& bytes) {
   static constexpr char kDigits[] =
@@ -249,6 +166,7 @@ json MontageData(const MontageFolder& folder, const ReportOptions& options, std:
   }
   const fs::path segments_path = dir / "segments.csv";
   const CsvTable segments = ReadCsvTable(segments_path);
+  std::vector<montage::MontageSegment> played;
   for (std::size_t r = 0; r < segments.rows.size(); ++r) {
     json s;
     for (const char* key : {"take", "reference_first", "reference_last", "source_first",
@@ -256,8 +174,22 @@ json MontageData(const MontageFolder& folder, const ReportOptions& options, std:
       s[key] = static_cast<int>(NumberAt(segments, r, ColumnOf(segments, key, segments_path),
                                          segments_path));
     }
+    played.push_back({s["take"], s["reference_first"], s["reference_last"], s["source_first"],
+                      s["source_last"], s["montage_first"], s["montage_last"]});
     data["segments"].push_back(s);
   }
+  // Every take at its own frame for each montage frame (the 3D view's clocks).
+  MontageClock clock;
+  try {
+    clock = ComputeMontageClock(played, warps);
+  } catch (const InputError& e) {
+    ThrowBadValue(segments_path.string(), e.what(), "the segments mmh wrote with timeline.csv");
+  }
+  if (clock.reference.size() != montage.size()) {
+    ThrowBadValue(segments_path.string(), std::to_string(clock.reference.size()) + " montage frames",
+                  std::to_string(montage.size()) + " (the frames of montage.tum)");
+  }
+  data["clock"] = {{"reference", clock.reference}, {"takes", clock.takes}};
   const json summary = ReadJsonFile(dir / "summary.json");
   std::vector<double> dtw_costs(m, std::nan(""));
   if (summary.contains("dtw_costs") && summary["dtw_costs"].size() == m) {
@@ -336,6 +268,25 @@ json ComposeData(const fs::path& dir, const ReportOptions& options, std::string*
   }
   json data = MontageData(folder, options, glb);
   data["title"] = "Montage of " + std::to_string(folder.takes.size()) + " takes";
+  // Layered objects (mmh compose --layer-takes): composed without time warping, each in
+  // layers/NAME/; the 3D view plays them beside the first object.
+  if (summary.contains("layers")) {
+    for (const json& layer : summary["layers"]) {
+      const std::string name = layer.value("name", "");
+      const fs::path layer_dir = dir / "layers" / name;
+      const json layer_summary = ReadJsonFile(layer_dir / "summary.json");
+      data["tables"].push_back(TableJson(
+          "Layered object " + name + ": segments", layer_dir / "segments.csv",
+          std::to_string(layer_summary.value("takes", 0)) + " takes composed without time "
+          "warping; total cost " + layer_summary.value("total_cost", json()).dump() +
+          (layer_summary.contains("warnings") && !layer_summary["warnings"].empty()
+               ? "; warnings: " + layer_summary["warnings"].dump()
+               : "")));
+    }
+    data["title"] = data["title"].get<std::string>() + " and " +
+                    std::to_string(summary["layers"].size()) +
+                    (summary["layers"].size() == 1 ? " layered object" : " layered objects");
+  }
   return data;
 }
 
@@ -384,10 +335,7 @@ json StudyData(const fs::path& dir) {
   for (const auto& [name, title] : figures) {
     const fs::path path = dir / (name + ".svg");
     if (!fs::exists(path)) continue;
-    std::string svg = ReadTextFile(path);
-    // Inline SVG: drop an XML declaration.
-    if (svg.rfind("<?xml", 0) == 0) svg = svg.substr(svg.find("?>") + 2);
-    data["figures"].push_back({{"title", title}, {"svg", svg}});
+    data["figures"].push_back({{"title", title}, {"svg", InlineSvg(path)}});
   }
   data["tables"] = json::array();
   data["tables"].push_back(TableJson("The tests", dir / "tests.csv", "docs/statistics.md"));
@@ -406,6 +354,24 @@ json StudyData(const fs::path& dir) {
   return data;
 }
 
+// mmh stats's folder: the tests, the scores and the analysis's text (docs/statistics.md).
+json StatsData(const fs::path& dir) {
+  json data;
+  data["title"] = "Statistics of study data (mmh stats)";
+  data["tables"] = json::array();
+  data["tables"].push_back(TableJson("The tests", dir / "tests.csv", "docs/statistics.md"));
+  data["tables"].push_back(TableJson("Take scores", dir / "take_scores.csv",
+                                     "m_ij per take (Figures 9 and 11)"));
+  data["tables"].push_back(TableJson("Animator scores", dir / "animator_scores.csv"));
+  if (fs::exists(dir / "mean_ranks.csv")) {
+    data["tables"].push_back(TableJson("Mean ranks", dir / "mean_ranks.csv"));
+  }
+  if (fs::exists(dir / "report.txt")) {
+    data["texts"].push_back({{"title", "report.txt"}, {"text", ReadTextFile(dir / "report.txt")}});
+  }
+  return data;
+}
+
 }  // namespace
 
 const char* FolderKindName(FolderKind kind) {
@@ -413,6 +379,8 @@ const char* FolderKindName(FolderKind kind) {
     case FolderKind::kCompose: return "compose";
     case FolderKind::kRun: return "run";
     case FolderKind::kStudy: return "study";
+    case FolderKind::kStats: return "stats";
+    case FolderKind::kSweep: return "sweep";
   }
   return "?";
 }
@@ -431,18 +399,31 @@ FolderKind DetectFolderKind(const fs::path& dir) {
     return FolderKind::kCompose;
   }
   if (has("rankings.csv") && has("comparisons.csv") && has("tests.csv")) return FolderKind::kStudy;
+  if (has("results.json") && has("tests.csv") && has("take_scores.csv") &&
+      has("animator_scores.csv")) {
+    return FolderKind::kStats;
+  }
+  if (has("plan.json") && has("configs")) return FolderKind::kSweep;
   ThrowBadValue(dir.string(), "a folder of another kind",
                 "the output of mmh compose (montage.tum, timeline.csv, segments.csv, "
-                "summary.json), mmh run (montage/, takes/, metrics.json) or mmh study "
-                "(rankings.csv, comparisons.csv, tests.csv)");
+                "summary.json), mmh run (montage/, takes/, metrics.json), mmh study "
+                "(rankings.csv, comparisons.csv, tests.csv), mmh stats (results.json, tests.csv, "
+                "take_scores.csv, animator_scores.csv) or mmh sweep (plan.json, configs/; "
+                "results.csv, summary.csv, failures.csv, variance_shares.csv after mmh sweep "
+                "aggregate)");
 }
 
 std::string BuildReportHtml(const fs::path& dir, FolderKind kind, const ReportOptions& options) {
   options.Validate("report.");
   std::string glb;
-  json data = kind == FolderKind::kCompose ? ComposeData(dir, options, &glb)
-              : kind == FolderKind::kRun   ? RunData(dir, options, &glb)
-                                           : StudyData(dir);
+  json data;
+  switch (kind) {
+    case FolderKind::kCompose: data = ComposeData(dir, options, &glb); break;
+    case FolderKind::kRun: data = RunData(dir, options, &glb); break;
+    case FolderKind::kStudy: data = StudyData(dir); break;
+    case FolderKind::kStats: data = StatsData(dir); break;
+    case FolderKind::kSweep: data = SweepData(dir); break;
+  }
   data["kind"] = FolderKindName(kind);
   data["folder"] = fs::absolute(dir).lexically_normal().string();
   const std::string title = data["title"];

@@ -1,5 +1,5 @@
-// `mmh report DIR`: one self-contained HTML file (DIR/report.html) of a compose, run or study
-// folder: scripts, styles, figures and the glTF inlined, no network at view time. The page's code
+// `mmh report DIR`: one self-contained HTML file (DIR/report.html) of a compose, run, study, stats
+// or sweep folder: scripts, styles, figures and the glTF inlined, no network at view time. The page's code
 // is report/web/src (three.js and the figures), bundled at build time.
 #pragma once
 
@@ -12,6 +12,8 @@ enum class FolderKind {
   kCompose,  // mmh compose: montage.tum, timeline.csv, segments.csv, summary.json
   kRun,      // mmh run: montage/, takes/take_K/, metrics.json
   kStudy,    // mmh study: rankings.csv, comparisons.csv, figure8..11 .svg
+  kStats,    // mmh stats: results.json, tests.csv, take_scores.csv, animator_scores.csv
+  kSweep,    // mmh sweep (after mmh sweep aggregate): plan.json, cells/, results.csv, summary.csv
 };
 
 const char* FolderKindName(FolderKind kind);

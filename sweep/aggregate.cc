@@ -135,6 +135,39 @@ double VarianceShare(const std::vector<double>& values, const std::vector<int>& 
   return std::clamp(between / total, 0.0, 1.0);
 }
 
+std::vector<MetricAxisPlot> MetricAxisPlots(const Plan& plan, const std::vector<ResultRow>& rows) {
+  std::vector<MetricAxisPlot> plots;
+  const auto& metrics = plan.spec.metrics;
+  for (std::size_t m = 0; m < metrics.size(); ++m) {
+    for (std::size_t x = 0; x < plan.axes.size(); ++x) {
+      const AxisInfo& axis = plan.axes[x];
+      if (!axis.numeric) continue;
+      LinePlot plot;
+      plot.title = metrics[m].name + " against " + axis.key;
+      plot.x_label = axis.key;
+      plot.y_label = metrics[m].name;
+      plot.log_x = axis.scale == AxisScale::kLog;
+      const std::vector<int> group = GroupsOf(plan, rows, x, nullptr);
+      std::map<int, std::pair<std::vector<double>, std::vector<double>>> by_group;
+      for (std::size_t r = 0; r < rows.size(); ++r) {
+        by_group[group[r]].first.push_back(plan.cells[rows[r].cell].params[x].second.get<double>());
+        by_group[group[r]].second.push_back(rows[r].metrics[m]);
+      }
+      for (const auto& [g, xy] : by_group) {
+        const MeanCi dx = Describe(xy.first);
+        const MeanCi dy = Describe(xy.second);
+        plot.points.push_back({dx.mean, dy.mean, dy.ci_low, dy.ci_high});
+      }
+      std::sort(plot.points.begin(), plot.points.end(),
+                [](const LinePoint& p, const LinePoint& q) { return p.x < q.x; });
+      if (plot.points.size() < 2) continue;
+      plots.push_back({static_cast<int>(m), static_cast<int>(x),
+                       metrics[m].name + "_vs_" + axis.key + ".svg", std::move(plot)});
+    }
+  }
+  return plots;
+}
+
 Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
   Aggregate a;
   const auto& metrics = plan.spec.metrics;
@@ -252,31 +285,10 @@ Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
   if (a.rows.empty()) return a;
   a.plots.emplace_back("variance_shares.svg", VarianceSharesSvg(bars));
 
+  const std::vector<MetricAxisPlot> line_plots = MetricAxisPlots(plan, a.rows);
   for (std::size_t m = 0; m < metrics.size(); ++m) {
-    for (std::size_t x = 0; x < plan.axes.size(); ++x) {
-      const AxisInfo& axis = plan.axes[x];
-      if (!axis.numeric) continue;
-      LinePlot plot;
-      plot.title = metrics[m].name + " against " + axis.key;
-      plot.x_label = axis.key;
-      plot.y_label = metrics[m].name;
-      plot.log_x = axis.scale == AxisScale::kLog;
-      const std::vector<int> group = GroupsOf(plan, a.rows, x, nullptr);
-      std::map<int, std::pair<std::vector<double>, std::vector<double>>> by_group;
-      for (std::size_t r = 0; r < a.rows.size(); ++r) {
-        by_group[group[r]].first.push_back(
-            plan.cells[a.rows[r].cell].params[x].second.get<double>());
-        by_group[group[r]].second.push_back(a.rows[r].metrics[m]);
-      }
-      for (const auto& [g, xy] : by_group) {
-        const MeanCi dx = Describe(xy.first);
-        const MeanCi dy = Describe(xy.second);
-        plot.points.push_back({dx.mean, dy.mean, dy.ci_low, dy.ci_high});
-      }
-      std::sort(plot.points.begin(), plot.points.end(),
-                [](const LinePoint& p, const LinePoint& q) { return p.x < q.x; });
-      if (plot.points.size() < 2) continue;
-      a.plots.emplace_back(metrics[m].name + "_vs_" + axis.key + ".svg", LinePlotSvg(plot));
+    for (const MetricAxisPlot& p : line_plots) {
+      if (p.metric == static_cast<int>(m)) a.plots.emplace_back(p.file, LinePlotSvg(p.plot));
     }
     // A heat map over the first two grid axes.
     std::vector<std::size_t> grid_axes;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sweep/plan.h"
+#include "sweep/plots.h"
 
 namespace mmh::sweep {
 
@@ -32,6 +33,16 @@ struct Aggregate {
 
 // Reads every cell and computes the tables and plots (writes nothing).
 Aggregate AggregateSweep(const Plan& plan, const std::filesystem::path& dir);
+
+// A metric against a numeric axis as plots/<metric>_vs_<axis>.svg draws it: the mean of the rows
+// at each of the axis's values (sampled axes: bins) over the other axes, with its 95 % CI.
+struct MetricAxisPlot {
+  int metric = 0;  // spec.metrics index
+  int axis = 0;    // plan.axes index
+  std::string file;  // the plot's name in plots/ (before WriteAggregate's character cleaning)
+  LinePlot plot;
+};
+std::vector<MetricAxisPlot> MetricAxisPlots(const Plan& plan, const std::vector<ResultRow>& rows);
 
 // Writes the tables into DIR and the plots into DIR/plots/ (each file atomically).
 void WriteAggregate(const std::filesystem::path& dir, const Aggregate& aggregate);

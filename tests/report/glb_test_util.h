@@ -76,7 +76,8 @@ inline int NodeIndex(const Glb& glb, const std::string& name) {
 }
 
 // The animated pose of node `name` in animation `animation` (parent_T_node in glTF's axes), with
-// the timestamps restored from the animation's extras (mmh_time_origins_s).
+// the timestamps restored from the animation's extras (mmh_time_origins_s, and the exact times
+// mmh_frame_periods_s or mmh_times_s where present).
 inline Trajectory AnimatedTrajectory(const Glb& glb, const std::string& animation,
                                      const std::string& name) {
   Trajectory out;
@@ -98,7 +99,15 @@ inline Trajectory AnimatedTrajectory(const Glb& glb, const std::string& animatio
     for (std::size_t i = 0; i < times.size() && 4 * i + 3 < rotations.size() &&
                             3 * i + 2 < translations.size();
          ++i) {
-      out.timestamps.push_back(origin + times[i]);
+      // Exact times from the extras where the writer put them (report/gltf_scene.h).
+      const auto& extras = a["extras"];
+      if (extras.contains("mmh_frame_periods_s") && extras["mmh_frame_periods_s"].contains(name)) {
+        out.timestamps.push_back(origin + double(i) * extras["mmh_frame_periods_s"][name].get<double>());
+      } else if (extras.contains("mmh_times_s") && extras["mmh_times_s"].contains(name)) {
+        out.timestamps.push_back(origin + extras["mmh_times_s"][name][i].get<double>());
+      } else {
+        out.timestamps.push_back(origin + times[i]);
+      }
       out.poses.push_back(Rigid3(
           Eigen::Quaterniond(rotations[4 * i + 3], rotations[4 * i], rotations[4 * i + 1],
                              rotations[4 * i + 2]),

@@ -113,6 +113,44 @@ TEST(GltfScene, TrajectoryReadsBackToTheInput) {
   test_util::ExpectValidGltf({dir / "soldier.glb"});
 }
 
+// Past 16.8 s float32 keyframe times are off by more than 1e-6 s: the exact times come back from
+// the extras, as a frame period (evenly sampled) or a list (uneven); the float times stay the
+// keyframes' (to half a unit in the last place).
+TEST(GltfScene, LongTracksReadBackTheirTimesExactly) {
+  test_util::TempDir dir;
+  Trajectory even = RandomTrajectory(3000, 2);  // 100 s at 30 Hz
+  Trajectory uneven = even;
+  std::mt19937_64 rng(3);
+  for (std::size_t i = 1; i < uneven.size(); ++i) {  // sensor jitter of up to 3 ms
+    uneven.timestamps[i] += std::uniform_real_distribution<double>(-0.003, 0.003)(rng);
+  }
+  const TriangleMesh mesh = OrientedStandIn();
+  for (const auto& [name, trajectory] : {std::pair{"even", even}, std::pair{"uneven", uneven}}) {
+    SCOPED_TRACE(name);
+    WriteGlb(dir / (std::string(name) + ".glb"), TrajectoryScene(mesh, trajectory, {.name = name}));
+    const test_util::Glb glb = ParseGlb(test_util::ReadBytes(dir / (std::string(name) + ".glb")));
+    const auto& extras = glb.json["animations"][0]["extras"];
+    EXPECT_EQ(extras.contains("mmh_frame_periods_s"), std::string(name) == "even") << extras.dump().substr(0, 200);
+    EXPECT_EQ(extras.contains("mmh_times_s"), std::string(name) == "uneven");
+    const Trajectory read = FromGltf(AnimatedTrajectory(glb, name, name), TrajectoryFrame::kTable);
+    ExpectSameTrajectory(trajectory, read, 1e-6);
+    // The keyframes themselves (what a viewer plays): within half a float ulp of 100 s (3.8e-6).
+    const auto times = test_util::AccessorFloats(
+        glb, glb.json["animations"][0]["samplers"][0]["input"].get<int>());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      worst = std::max(worst, std::abs(times[i] - (trajectory.timestamps[i] - trajectory.timestamps[0])));
+    }
+    EXPECT_GT(worst, 1e-6);  // so the extras are needed
+    EXPECT_LE(worst, 3.9e-6);
+  }
+  // Short tracks (6.6 s) need no extras.
+  WriteGlb(dir / "short.glb", TrajectoryScene(mesh, RandomTrajectory(200, 4), {}));
+  const auto& extras = ParseGlb(test_util::ReadBytes(dir / "short.glb")).json["animations"][0]["extras"];
+  EXPECT_FALSE(extras.contains("mmh_frame_periods_s") || extras.contains("mmh_times_s"));
+  test_util::ExpectValidGltf({dir / "even.glb", dir / "uneven.glb"});
+}
+
 TEST(GltfScene, CameraFrameAndStandIn) {
   test_util::TempDir dir;
   const Trajectory camera_T_proxy = RandomTrajectory(50, 2);

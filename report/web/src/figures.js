@@ -81,12 +81,16 @@ export function segmentSection(data, listeners) {
   for (const frame of data.markers) g.fillRect(Math.round((frame / montageFrames) * kWidth) - 2, 0, 5, 24);
   node.append(row('reference timeline', reference));
   node.append(row('montage', montage));
-  // The scrubber's position on both timelines.
+  // The scrubber's montage frame and the reference frame it was played from.
   const cursor = element('div', { class: 'cursor' });
+  const referenceCursor = element('div', { class: 'cursor' });
   montage.parentElement.style.position = 'relative';
   montage.parentElement.append(cursor);
-  listeners.push((frame) => {
+  reference.parentElement.style.position = 'relative';
+  reference.parentElement.append(referenceCursor);
+  listeners.push((frame, t) => {
     cursor.style.left = `${montage.offsetLeft + (frame / montageFrames) * montage.clientWidth}px`;
+    referenceCursor.style.left = `${reference.offsetLeft + (t / n) * reference.clientWidth}px`;
   });
   const legend = element('p', { class: 'legend' });
   data.takes.forEach((take, l) => {

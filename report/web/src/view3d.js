@@ -1,6 +1,8 @@
 // The 3D view: the montage.glb that mmh wrote (the montage with its spatial markers, every take
 // warped to the reference timeline and as recorded) played by three.js, in sync with a scrubber
-// in montage frames.
+// in montage frames: at montage frame k every node shows its own frame (report/montage_clock.h):
+// the montage its k-th, a warped take the reference frame t that k was played from, a recorded
+// take its own frame w_K(t) (the chosen take: the very frame the montage plays).
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -19,16 +21,19 @@ function softwareRenderer() {
 }
 
 export class View3d {
-  // montage: {frames, node (the montage node's glTF name)}; onFrame(frame) after every move.
-  constructor(host, montage, onFrame) {
+  // montage: {frames, node (the montage node's glTF name)}; clock: {reference: [t per montage
+  // frame], takes: [[take K's frame per montage frame]]}; onFrame(frame, t) after every move.
+  constructor(host, montage, clock, onFrame) {
     this.montage = montage;
+    this.clock = clock;
     this.onFrame = onFrame;
     host.append(Object.assign(document.createElement('h2'), { textContent: '3D view' }));
     host.append(Object.assign(document.createElement('p'), {
       className: 'note',
       textContent: 'Left: the montage (grey: spatial markers); then each take, warped to the ' +
-        'reference timeline (front row) and as recorded (back row). Every animation starts at ' +
-        'time 0 and plays at its own frame rate; drag to orbit.',
+        'reference timeline (front row) and as recorded (back row). At montage frame k the ' +
+        'warped takes show the reference frame t that k was played from and the recorded takes ' +
+        'their own frame w_K(t) (the chosen take: the frame the montage plays); drag to orbit.',
     }));
     this.canvas = document.createElement('canvas');
     this.canvas.width = 900;
@@ -71,17 +76,38 @@ export class View3d {
         this.scene.add(this.root);
         this.clip = gltf.animations.find((a) => a.name === 'montage') || gltf.animations[0];
         this.mixer = new THREE.AnimationMixer(this.root);
-        // Played once and held at the end: a repeating action would wrap the last frame (at the
-        // clip's duration) back to the first.
-        const action = this.mixer.clipAction(this.clip);
-        action.setLoop(THREE.LoopOnce, 1);
-        action.clampWhenFinished = true;
-        action.play();
+        // One action per node, each set to its own time (the node's clock).
+        const byNode = new Map();
+        for (const track of this.clip.tracks) {
+          const node = track.name.slice(0, track.name.lastIndexOf('.'));
+          if (!byNode.has(node)) byNode.set(node, []);
+          byNode.get(node).push(track);
+        }
         const name = THREE.PropertyBinding.sanitizeNodeName(this.montage.node);
+        // The clocks are the first object's; layered objects were recorded while its montage
+        // played (no time warp): their nodes show frame k of their own tracks.
+        const object = name.slice(0, -'_montage'.length);
+        const ofObject = new RegExp(`^${object}_take_(\\d+)_(warped|recorded)$`);
+        this.clocks = [];
+        for (const [node, tracks] of byNode) {
+          const action = this.mixer.clipAction(new THREE.AnimationClip(node, -1, tracks));
+          // Held at its end: a repeating action would wrap the last frame back to the first.
+          action.setLoop(THREE.LoopOnce, 1);
+          action.clampWhenFinished = true;
+          action.play();
+          const take = node.match(ofObject);
+          this.clocks.push({
+            node, action, times: tracks[0].times,
+            role: take ? take[2] : node === name ? 'montage' : 'layer', take: take ? Number(take[1]) - 1 : -1,
+          });
+        }
         this.node = this.root.getObjectByName(name);
         const track = this.clip.tracks.find((t) => t.name === `${name}.position`);
         if (!this.node || !track) throw new Error(`montage.glb has no animated node ${name}`);
         this.times = track.times;  // the montage's keyframe times: frame k plays at times[k]
+        if (this.clock.reference.length !== this.times.length) {
+          throw new Error(`montage.glb has ${this.times.length} montage frames, the timeline ${this.clock.reference.length}`);
+        }
         this.frame(this.root);
         this.showFrame(0);
         resolve();
@@ -113,15 +139,21 @@ export class View3d {
     this.controls.update();
   }
 
-  // Moves every animation to montage frame `frame` (clamped) and draws.
+  // Moves every node to its own frame at montage frame `frame` (clamped) and draws.
   showFrame(frame) {
     const k = Math.max(0, Math.min(this.times.length - 1, Math.round(frame)));
+    const t = this.clock.reference[k];
     this.current = k;
     this.scrubber.value = String(k);
-    this.mixer.setTime(this.times[k]);
-    this.label.textContent = ` frame ${k} / ${this.times.length - 1}  (${this.times[k].toFixed(3)} s)`;
+    for (const c of this.clocks) {
+      const index = c.role === 'warped' ? t : c.role === 'recorded' ? this.clock.takes[c.take][k] : k;
+      c.action.time = c.times[Math.min(index, c.times.length - 1)];
+    }
+    this.mixer.update(0);
+    this.label.textContent = ` frame ${k} / ${this.times.length - 1}  (${this.times[k].toFixed(3)} s)` +
+      `  reference frame ${t}; takes at ${this.clock.takes.map((w, K) => `${K + 1}: ${w[k]}`).join(', ')}`;
     this.render();
-    this.onFrame(k);
+    this.onFrame(k, t);
   }
 
   render() {
@@ -145,9 +177,15 @@ export class View3d {
     requestAnimationFrame(step);
   }
 
-  // For the browser test: the montage node's local pose (glTF axes) after the last move.
+  // For the browser test: the montage node's local pose (glTF axes) after the last move, and
+  // every animated node's (by glTF node name).
   montagePose() {
-    return { position: this.node.position.toArray(), quaternion: this.node.quaternion.toArray() };
+    const nodes = {};
+    for (const c of this.clocks) {
+      const node = this.root.getObjectByName(c.node);
+      nodes[c.node] = { position: node.position.toArray(), quaternion: node.quaternion.toArray() };
+    }
+    return { position: this.node.position.toArray(), quaternion: this.node.quaternion.toArray(), nodes };
   }
 
   // For the browser test: pixels of the drawn canvas that differ from the background.
@@ -166,15 +204,21 @@ export class View3d {
     return { count, total: w * h };
   }
 
-  // Scrubbing cost: mean milliseconds to move to a frame and draw it (finished on the GPU).
+  // Scrubbing cost: milliseconds to move to a frame and draw it (finished on the GPU), over
+  // `steps` frames spread over the montage: {mean, median, p95, max}.
   scrubMilliseconds(steps) {
     const gl = this.renderer.getContext();
     const probe = new Uint8Array(4);
-    const t0 = performance.now();
+    const times = [];
     for (let i = 0; i < steps; ++i) {
+      const t0 = performance.now();
       this.showFrame(Math.floor((i * (this.times.length - 1)) / Math.max(1, steps - 1)));
       gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, probe);
+      times.push(performance.now() - t0);
     }
-    return (performance.now() - t0) / steps;
+    const sorted = times.slice().sort((a, b) => a - b);
+    const at = (q) => sorted[Math.min(sorted.length - 1, Math.floor(q * sorted.length))];
+    return { mean: times.reduce((a, b) => a + b, 0) / steps, median: at(0.5), p95: at(0.95),
+      max: sorted[sorted.length - 1] };
   }
 }

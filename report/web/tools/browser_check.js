@@ -2,9 +2,11 @@
 // prints what the browser test checks, as JSON: console errors and uncaught exceptions, network
 // requests other than the file itself, the 3D canvas's non-background pixels, the montage node's
 // pose after moving the scrubber to each requested frame, the cost of a scrub step and the frame
-// rate while playing; optionally a full-page screenshot.
+// rate while playing; the page's tables, plots and counts read back from its DOM; optionally a
+// full-page screenshot.
 //   node --experimental-websocket browser_check.js --chromium PATH --html FILE
 //        [--frames 0,10,...] [--screenshot OUT.png] [--timeout-ms 60000]
+//        [--scrub-steps 60] [--play-seconds 1]   (the scrubbing measurement, bench/README.md)
 // Exit 0 when the page loaded (the checks are the caller's), 2 on a usage or browser error.
 'use strict';
 const { spawn } = require('child_process');
@@ -13,7 +15,7 @@ const os = require('os');
 const path = require('path');
 
 function parseArgs(argv) {
-  const args = { frames: [], timeoutMs: 60000 };
+  const args = { frames: [], timeoutMs: 60000, scrubSteps: 60, playSeconds: 1 };
   for (let i = 0; i < argv.length; i += 2) {
     const [key, value] = [argv[i], argv[i + 1]];
     if (key === '--chromium') args.chromium = value;
@@ -21,6 +23,8 @@ function parseArgs(argv) {
     else if (key === '--frames') args.frames = value.split(',').filter((s) => s).map(Number);
     else if (key === '--screenshot') args.screenshot = value;
     else if (key === '--timeout-ms') args.timeoutMs = Number(value);
+    else if (key === '--scrub-steps') args.scrubSteps = Number(value);
+    else if (key === '--play-seconds') args.playSeconds = Number(value);
     else throw new Error(`unknown argument ${key}`);
   }
   if (!args.chromium || !args.html) throw new Error('--chromium and --html are required');
@@ -123,6 +127,8 @@ async function check(args) {
     result.page_errors = await evaluate('window.mmhReport ? window.mmhReport.errors : ["no mmhReport"]');
     result.kind = await evaluate('window.mmhReport && window.mmhReport.data.kind');
     result.has_view = await evaluate('!!(window.mmhReport && window.mmhReport.view)');
+    // What the page shows, read back from its DOM (tables, plots, cell counts).
+    if (result.ready) result.page = await evaluate('mmhReport.inspect()');
     if (result.ready && result.has_view) {
       result.montage_frames = await evaluate('mmhReport.view.times.length');
       result.pixels = await evaluate('mmhReport.view.foregroundPixels()');
@@ -134,12 +140,13 @@ async function check(args) {
           return mmhReport.view.montagePose(); })()`);
         result.poses.push({ frame, ...pose });
       }
-      result.scrub_ms = await evaluate('mmhReport.view.scrubMilliseconds(60)');
-      // Frame rate while playing: requestAnimationFrame callbacks per second over one second.
+      result.scrub = await evaluate(`mmhReport.view.scrubMilliseconds(${args.scrubSteps})`);
+      result.scrub_ms = result.scrub.mean;
+      // Frame rate while playing: requestAnimationFrame callbacks per second over --play-seconds.
       result.playback_fps = await evaluate(`new Promise((resolve) => {
         mmhReport.view.showFrame(0); mmhReport.view.toggle();
         let n = 0; const t0 = performance.now();
-        const f = () => { ++n; if (performance.now() - t0 < 1000) requestAnimationFrame(f);
+        const f = () => { ++n; if (performance.now() - t0 < ${1000 * args.playSeconds}) requestAnimationFrame(f);
           else { if (mmhReport.view.playing) mmhReport.view.toggle();
                  resolve(n / ((performance.now() - t0) / 1000)); } };
         requestAnimationFrame(f); })`);
