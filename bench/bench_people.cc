@@ -15,7 +15,7 @@
 
 namespace {
 
-using namespace mmh::sim;
+using namespace mmh::people;
 
 const Story& Soldier() {
   static const Story story =

@@ -63,7 +63,7 @@ void BM_SoldierAnimatorFast(benchmark::State& state) {
   int animator = 0;
   for (auto _ : state) {
     const pipeline::AnimatorRun run = pipeline::RunAnimator(config, animator++ % 20);
-    benchmark::DoNotOptimize(run.metrics.size());
+    benchmark::DoNotOptimize(run.metrics->takes.size());
   }
 }
 BENCHMARK(BM_SoldierAnimatorFast)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -82,7 +82,7 @@ void BM_ScoringAndAnalysis(benchmark::State& state) {
   std::vector<mmh::study::AnimationAppeals> appeals(20);
   for (int i = 0; i < 20; ++i) {
     for (int k = 0; k < 3; ++k) {
-      mmh::sim::Appeal a;
+      mmh::people::Appeal a;
       a.mean_quality = 0.3 + 0.02 * i + 0.05 * k;
       appeals[i].takes.push_back(a);
     }

@@ -7,7 +7,7 @@
 #include "core/error.h"
 #include "people/random.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 constexpr double kSliderLimit = 5.0;
@@ -177,4 +177,4 @@ AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorP
   return session;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -28,7 +28,7 @@
 #include "core/annotation.h"
 #include "core/cross_correlation.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 // One annotator (the judging half of a simulated participant).
 struct AnnotatorProfile {
@@ -99,4 +99,4 @@ AnnotationSession AnnotateTake(std::span<const double> quality, const AnnotatorP
 // CrossCorrelationLag (core/cross_correlation.h) estimates a session's lag.
 using mmh::CrossCorrelationLag;
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

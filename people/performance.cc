@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "people/random.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -716,4 +716,4 @@ PerformedTake PerformLayeredTake(const Story& story, int object, const AnimatorP
   return result;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -16,7 +16,7 @@
 #include "people/story.h"
 #include "people/take_quality.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 // Who acts (the performer half of a simulated participant).
 struct AnimatorProfile {
@@ -154,4 +154,4 @@ PerformedTake PerformLayeredTake(const Story& story, int object, const AnimatorP
                                  const PerformanceOptions& options, std::uint64_t seed,
                                  int min_marker_gap = 60);
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

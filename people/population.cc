@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "people/random.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 void PopulationOptions::Validate(const std::string& prefix) const {
   for (const auto& [mean, name] : {std::pair{skill_mean, "skill_mean"},
@@ -71,4 +71,4 @@ Participant DrawParticipant(const PopulationOptions& p, int index) {
   return participant;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -9,7 +9,7 @@
 #include "people/annotator.h"
 #include "people/performance.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 // Config section "population". Normal distributions truncated to each field's range.
 struct PopulationOptions {
@@ -72,4 +72,4 @@ Participant DrawParticipant(const PopulationOptions& population, int index);
 // The seed of everything participant `index` does (takes, annotations): independent streams.
 std::uint64_t ParticipantSeed(const PopulationOptions& population, int index);
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 std::uint64_t SplitMix64(std::uint64_t x) {
@@ -51,4 +51,4 @@ int Random::Index(int n) {
 
 double Random::Exponential(double mean) { return -mean * std::log1p(-Uniform()); }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -8,7 +8,7 @@
 #include <initializer_list>
 #include <random>
 
-namespace mmh::sim {
+namespace mmh::people {
 
 // A seed for one independent stream, derived from a base seed and tags (animator, take, ...), so
 // that streams never depend on the order in which they are drawn (SplitMix64 finaliser chain).
@@ -37,4 +37,4 @@ class Random {
   double spare_ = 0.0;
 };
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -2,7 +2,7 @@
 
 #include "core/error.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 void SelfAppraisalOptions::Validate(const std::string& prefix) const {
   // Both biases flatter the animator's own later work; negative values would model the opposite
@@ -24,4 +24,4 @@ double SelfAppraisalBias(const SelfAppraisalOptions& options, int item, int take
   return options.progress_weight * progress;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -24,7 +24,7 @@
 
 #include <string>
 
-namespace mmh::sim {
+namespace mmh::people {
 
 // Config section "self_appraisal".
 struct SelfAppraisalOptions {
@@ -44,4 +44,4 @@ struct SelfAppraisalOptions {
 // montage (items 0..takes−1 the takes in recording order, item `takes` the montage).
 double SelfAppraisalBias(const SelfAppraisalOptions& options, int item, int takes);
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -10,7 +10,7 @@
 #include "core/options.h"
 #include "core/text_parsing.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 constexpr std::pair<BeatKind, const char*> kBeatKindNames[] = {
@@ -386,4 +386,4 @@ double DistanceToPolyline(std::span<const Eigen::Vector2d> points, const Eigen::
   return best;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

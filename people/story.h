@@ -39,7 +39,7 @@
 
 #include "core/table_setup.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 enum class BeatKind {
   kStand,       // standing still
@@ -128,4 +128,4 @@ Eigen::Vector2d PolylinePoint(std::span<const Eigen::Vector2d> points, double s,
 // Distance from p to the polyline.
 double DistanceToPolyline(std::span<const Eigen::Vector2d> points, const Eigen::Vector2d& p);
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

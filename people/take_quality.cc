@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 double LogRatioScore(double measured, double target, double log_sd) {
@@ -210,4 +210,4 @@ QualityTrace ComputeTakeQuality(const QualityInputs& in, const QualityOptions& o
   return trace;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -27,7 +27,7 @@
 #include "core/trajectory.h"
 #include "people/story.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 // Config section "performance.quality".
 struct QualityOptions {
@@ -99,4 +99,4 @@ double TiltFromUpright(const Eigen::Quaterniond& table_R_proxy);
 // x-y plane.
 double FacingHeading(const Eigen::Quaterniond& table_R_proxy);
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

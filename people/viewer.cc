@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "people/random.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 // Rotation vector of q (axis times angle, shorter arc).
@@ -154,4 +154,4 @@ std::vector<double> CompositeQuality(std::span<const std::vector<double>> take_q
   return quality;
 }
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -23,7 +23,7 @@
 
 #include "core/trajectory.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 
 struct ViewerOptions {
   // w_a and σ are calibrated to the paper's study (docs/calibration.md).
@@ -90,4 +90,4 @@ std::vector<double> CompositeQuality(std::span<const std::vector<double>> take_q
                                      std::span<const int> take_of_frame,
                                      std::span<const int> source_frame);
 
-}  // namespace mmh::sim
+}  // namespace mmh::people

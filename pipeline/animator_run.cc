@@ -118,14 +118,14 @@ void SimulateSessions(const RunConfig& config, std::uint64_t seed, TakeRun& take
   const sim::CameraPlacement& camera = config.render.camera;
   SimulatedTracking tracking = SimulateTracking(
       take.truth, config.error_model,
-      sim::DeriveSeed(seed, {0x7472ull, static_cast<std::uint64_t>(take.performed.object),
+      people::DeriveSeed(seed, {0x7472ull, static_cast<std::uint64_t>(take.performed.object),
                              static_cast<std::uint64_t>(take.take)}),
       Eigen::Vector3d(camera.x, camera.y, camera.z));
   SetTracked(std::move(tracking.tracked.poses), std::move(tracking.status), take);
   if (!take.truth_annotation.values.empty()) {
     const SimulatedReading reading = SimulateSliderReading(
         take.truth_annotation, config.error_model,
-        sim::DeriveSeed(seed, {0x736cull, static_cast<std::uint64_t>(take.performed.object),
+        people::DeriveSeed(seed, {0x736cull, static_cast<std::uint64_t>(take.performed.object),
                                static_cast<std::uint64_t>(take.take)}));
     take.read_annotation = reading.read;
     take.slider_found = reading.found;
@@ -143,7 +143,7 @@ std::vector<double> MontageQuality(const montage::Montage& m, const std::vector<
       source_frame.push_back(f);
     }
   }
-  return sim::CompositeQuality(quality, take_of_frame, source_frame);
+  return people::CompositeQuality(quality, take_of_frame, source_frame);
 }
 
 }  // namespace
@@ -252,7 +252,7 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
   auto t0 = Clock::now();
   const sim::StoryScript script(render, render.render.story, render.render.object, animator);
   result.participant = script.participant();
-  const std::uint64_t seed = sim::ParticipantSeed(render.population, animator);
+  const std::uint64_t seed = people::ParticipantSeed(render.population, animator);
   std::optional<sim::StoryScript> practice_script;
   const int practice_takes = options.practice.empty() ? 0 : 1;
   std::vector<TakeRun> takes;  // the practice take first

@@ -93,8 +93,8 @@ struct RunConfig {
 // One take through the pipeline. Trajectories are table_T_proxy with timestamps i / frame_rate.
 struct TakeRun {
   int take = 0;                       // index within the story's object (0-based)
-  sim::PerformedTake performed;       // ground truth: motion, latent quality, flaws
-  sim::AnnotationSession annotation;  // ground truth: judgement, delay, slider block (not for the
+  people::PerformedTake performed;       // ground truth: motion, latent quality, flaws
+  people::AnnotationSession annotation;  // ground truth: judgement, delay, slider block (not for the
                                       // practice take, which is not annotated)
   Trajectory truth;    // #frames: the performed motion (render.frames may shorten the take)
   Trajectory tracked;  // #frames, lost frames filled (see RunOptions)
@@ -121,14 +121,14 @@ struct StageSeconds {
 };
 
 struct AnimatorRun {
-  sim::Participant participant;
+  people::Participant participant;
   std::optional<TakeRun> practice;
   std::vector<TakeRun> takes;
   montage::Montage montage;        // from the tracked takes and read annotations
   montage::Montage truth_montage;  // from the ground truth (empty unless run.metrics)
   TriangleMesh proxy_model;        // the takes' proxy (montage.glb shows it)
   // Latent quality of each montage frame, carried from the takes' frames it shows
-  // (sim::CompositeQuality).
+  // (people::CompositeQuality).
   std::vector<double> montage_quality;
   std::vector<double> truth_montage_quality;
   std::optional<RunMetrics> metrics;  // metrics.json; only with run.metrics

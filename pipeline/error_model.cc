@@ -40,7 +40,7 @@ void RequireEpisodeLength(double value, const std::string& where) {
 class Ar1 {
  public:
   Ar1(double sd, double rho) : sd_(sd), rho_(rho), innovation_(std::sqrt(1.0 - rho * rho)) {}
-  double Next(sim::Random& random) {
+  double Next(people::Random& random) {
     x_ = started_ ? rho_ * x_ + innovation_ * sd_ * random.Normal() : sd_ * random.Normal();
     started_ = true;
     return x_;
@@ -61,7 +61,7 @@ std::vector<int> DrawEpisodes(const std::vector<int>& condition, const ViewRates
                               const std::vector<int>& busy, std::uint64_t seed) {
   const int frames = static_cast<int>(condition.size());
   std::vector<int> episode(frames, -1);
-  sim::Random random(seed);
+  people::Random random(seed);
   int count = 0;
   bool in_episode = false;
   for (int t = 0; t < frames; ++t) {
@@ -245,15 +245,15 @@ SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOpti
   const ViewRates& view = options.view;
   const std::vector<int> lost =
       DrawEpisodes(condition, view, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, none,
-                   sim::DeriveSeed(seed, {kLossStream}));
+                   people::DeriveSeed(seed, {kLossStream}));
   const std::vector<int> flip =
       DrawEpisodes(condition, view, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, lost,
-                   sim::DeriveSeed(seed, {kFlipStream}));
+                   people::DeriveSeed(seed, {kFlipStream}));
   const std::vector<int> spike =
       DrawEpisodes(condition, view, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames,
-                   Union(lost, flip), sim::DeriveSeed(seed, {kSpikeStream}));
+                   Union(lost, flip), people::DeriveSeed(seed, {kSpikeStream}));
 
-  sim::Random random(sim::DeriveSeed(seed, {kPoseStream}));
+  people::Random random(people::DeriveSeed(seed, {kPoseStream}));
   std::array<Ar1, 6> axes = {Ar1(options.rotation_sd, options.correlation),
                              Ar1(options.rotation_sd, options.correlation),
                              Ar1(options.rotation_sd, options.correlation),
@@ -262,8 +262,8 @@ SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOpti
                              Ar1(options.translation_sd, options.correlation)};
   const Eigen::Quaterniond twin(Eigen::AngleAxisd(options.flip_rotation, Eigen::Vector3d::UnitZ()));
   // Each episode's shape: a flip's horizontal offset direction, a spike's error.
-  sim::Random flip_shape(sim::DeriveSeed(seed, {kFlipShapeStream}));
-  sim::Random spike_shape(sim::DeriveSeed(seed, {kSpikeShapeStream}));
+  people::Random flip_shape(people::DeriveSeed(seed, {kFlipShapeStream}));
+  people::Random spike_shape(people::DeriveSeed(seed, {kSpikeShapeStream}));
   int flip_episode = -1, spike_episode = -1;
   Eigen::Vector3d flip_offset = Eigen::Vector3d::Zero();
   Eigen::Vector3d spike_r = Eigen::Vector3d::Zero(), spike_e = Eigen::Vector3d::Zero();
@@ -314,7 +314,7 @@ SimulatedReading SimulateSliderReading(const Annotation& truth, const ErrorModel
   out.read.timestamps = truth.timestamps;
   out.read.values.assign(frames, 0.0);
   out.found.assign(frames, true);
-  sim::Random random(sim::DeriveSeed(seed, {kSliderStream}));
+  people::Random random(people::DeriveSeed(seed, {kSliderStream}));
   Ar1 noise(options.slider_sd, options.slider_correlation);
   int first_found = -1;
   for (int t = 0; t < frames; ++t) {

@@ -165,9 +165,9 @@ RenderConfig RenderConfig::FromConfig(const Config& config) {
   c.hand = config.Get<HandOptions>("hand");
   c.sensor = config.Get<KinectSensorOptions>("sensor");
   c.motion = config.Get<DemoMotionOptions>("motion");
-  c.population = config.Get<PopulationOptions>("population");
-  c.performance = config.Get<PerformanceOptions>("performance");
-  c.annotator = config.Get<AnnotatorOptions>("annotator");
+  c.population = config.Get<people::PopulationOptions>("population");
+  c.performance = config.Get<people::PerformanceOptions>("performance");
+  c.annotator = config.Get<people::AnnotatorOptions>("annotator");
   return c;
 }
 
@@ -258,8 +258,8 @@ struct Motion {
   TableTopScene::Hand hand = TableTopScene::Hand::kOnProxy;
   // Story-driven recordings.
   std::optional<StoryScript> script;
-  std::optional<PerformedTake> take;
-  std::optional<AnnotationSession> annotation;
+  std::optional<people::PerformedTake> take;
+  std::optional<people::AnnotationSession> annotation;
 };
 
 Motion ResolveMotion(const RenderConfig& config) {
@@ -315,8 +315,8 @@ Motion ResolveMotion(const RenderConfig& config) {
 // take.csv, flaws.csv, take.tum and participant.json of a story-driven recording.
 void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
                      const std::filesystem::path& out) {
-  const PerformedTake& take = *motion.take;
-  const StoryObject& object = motion.script->story().objects[take.object];
+  const people::PerformedTake& take = *motion.take;
+  const people::StoryObject& object = motion.script->story().objects[take.object];
   const double fps = config.performance.frame_rate;
   std::string csv =
       "frame,timestamp,beat,script_kind,performed_kind,progress,quality,fidelity,path,steadiness,"
@@ -324,11 +324,11 @@ void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
   if (motion.annotation) csv += ",judgement,delay,slider";
   csv += "\n";
   for (int i = 0; i < take.frames(); ++i) {
-    const QualityTrace& q = take.quality;
+    const people::QualityTrace& q = take.quality;
     csv += std::to_string(i) + "," + FormatNumber(i / fps) + "," +
            std::to_string(take.script_beat[i]) + "," +
-           BeatKindName(object.beats[take.script_beat[i]].kind) + "," +
-           BeatKindName(take.performed_kind[i]) + "," + FormatNumber(take.script_progress[i]) +
+           people::BeatKindName(object.beats[take.script_beat[i]].kind) + "," +
+           people::BeatKindName(take.performed_kind[i]) + "," + FormatNumber(take.script_progress[i]) +
            "," + FormatNumber(q.quality[i]) + "," + FormatNumber(q.fidelity[i]) + "," +
            FormatNumber(q.path[i]) + "," + FormatNumber(q.steadiness[i]) + "," +
            FormatNumber(q.expression[i]) + "," + FormatNumber(q.motion[i]);
@@ -341,7 +341,7 @@ void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
   }
   WriteFileAtomically(out / "take.csv", csv);
   std::string flaws = "kind,beat,first_frame,last_frame\n";
-  for (const Flaw& f : take.flaws) {
+  for (const people::Flaw& f : take.flaws) {
     flaws += std::string(EnumName(f.kind)) + "," + std::to_string(f.beat) + "," +
              std::to_string(f.first_frame) + "," + std::to_string(f.last_frame) + "\n";
   }

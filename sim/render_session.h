@@ -140,9 +140,9 @@ struct RenderConfig {
   HandOptions hand;
   KinectSensorOptions sensor;
   DemoMotionOptions motion;
-  PopulationOptions population;
-  PerformanceOptions performance;
-  AnnotatorOptions annotator;
+  people::PopulationOptions population;
+  people::PerformanceOptions performance;
+  people::AnnotatorOptions annotator;
 
   // Reads the render sections; the other sections of a study config (study, montage, track,
   // metrics, viewer, scorers) may be present and are left to the commands that use them.

@@ -17,7 +17,7 @@ StoryScript::StoryScript(const RenderConfig& config, const std::string& story_fi
                          int animator, const std::string& object_key)
     : config_(&config),
       story_file_(story_file),
-      story_(LoadStory(story_file, config.scene)),
+      story_(people::LoadStory(story_file, config.scene)),
       object_(object) {
   if (object < 0 || object >= static_cast<int>(story_.objects.size())) {
     ThrowBadValue(object_key, std::to_string(object),
@@ -25,7 +25,7 @@ StoryScript::StoryScript(const RenderConfig& config, const std::string& story_fi
                       std::to_string(story_.objects.size() - 1) + ")");
   }
   if (animator < 0) ThrowBadValue("animator", std::to_string(animator), "an index >= 0");
-  participant_ = DrawParticipant(config.population, animator);
+  participant_ = people::DrawParticipant(config.population, animator);
 }
 
 std::string StoryScript::ProxyFile() const {
@@ -36,21 +36,21 @@ std::string StoryScript::ProxyFile() const {
   return (std::filesystem::path(story_file_).parent_path() / path).lexically_normal().string();
 }
 
-PerformedTake StoryScript::Perform(int take) const {
-  return PerformTake(story_, object_, participant_.animator, take, config_->performance,
-                     ParticipantSeed(config_->population, participant_.index));
+people::PerformedTake StoryScript::Perform(int take) const {
+  return people::PerformTake(story_, object_, participant_.animator, take, config_->performance,
+                     people::ParticipantSeed(config_->population, participant_.index));
 }
 
-AnnotationSession StoryScript::Annotate(const PerformedTake& take) const {
-  AnnotatorOptions annotator = config_->annotator;
+people::AnnotationSession StoryScript::Annotate(const people::PerformedTake& take) const {
+  people::AnnotatorOptions annotator = config_->annotator;
   annotator.frame_rate = config_->performance.frame_rate;
-  const std::uint64_t seed = ParticipantSeed(config_->population, participant_.index);
-  return AnnotateTake(take.quality.quality, participant_.annotator, annotator,
-                      DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(take.object),
+  const std::uint64_t seed = people::ParticipantSeed(config_->population, participant_.index);
+  return people::AnnotateTake(take.quality.quality, participant_.annotator, annotator,
+                      people::DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(take.object),
                                         static_cast<std::uint64_t>(take.take)}));
 }
 
-SessionFrames StoryScript::RecordingFrames(const PerformedTake& take, int frames) const {
+SessionFrames StoryScript::RecordingFrames(const people::PerformedTake& take, int frames) const {
   SessionFrames s;
   s.table_T_proxy.assign(take.table_T_proxy.poses.begin(),
                          take.table_T_proxy.poses.begin() + frames);
@@ -58,7 +58,7 @@ SessionFrames StoryScript::RecordingFrames(const PerformedTake& take, int frames
   return s;
 }
 
-SessionFrames StoryScript::AnnotationFrames(const AnnotationSession& annotation,
+SessionFrames StoryScript::AnnotationFrames(const people::AnnotationSession& annotation,
                                             int frames) const {
   SessionFrames s;
   s.table_T_proxy.assign(frames, RestingTableTProxy());

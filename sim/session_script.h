@@ -34,29 +34,29 @@ class StoryScript {
   StoryScript(const RenderConfig& config, const std::string& story_file, int object, int animator,
               const std::string& object_key = "render.object");
 
-  const Story& story() const { return story_; }
+  const people::Story& story() const { return story_; }
   int object() const { return object_; }
-  const Participant& participant() const { return participant_; }
+  const people::Participant& participant() const { return participant_; }
   // The proxy model file of the story's object ("" for the Soldier; relative paths are relative
   // to the story file).
   std::string ProxyFile() const;
 
   // Take `take` (0-based; the skill index: a practice take counts) as the participant performs it.
-  PerformedTake Perform(int take) const;
+  people::PerformedTake Perform(int take) const;
   // The participant's annotation of a performed take: their slider while it plays.
-  AnnotationSession Annotate(const PerformedTake& take) const;
+  people::AnnotationSession Annotate(const people::PerformedTake& take) const;
 
   // The first `frames` frames of the take's recording session (the block rests at the
   // annotator's start value) and of its annotation session.
-  SessionFrames RecordingFrames(const PerformedTake& take, int frames) const;
-  SessionFrames AnnotationFrames(const AnnotationSession& annotation, int frames) const;
+  SessionFrames RecordingFrames(const people::PerformedTake& take, int frames) const;
+  SessionFrames AnnotationFrames(const people::AnnotationSession& annotation, int frames) const;
 
  private:
   const RenderConfig* config_;
   std::string story_file_;
-  Story story_;
+  people::Story story_;
   int object_;
-  Participant participant_;
+  people::Participant participant_;
 };
 
 // Where the proxy rests during an annotation session: on the table left of the play area.

@@ -17,7 +17,7 @@ enum Stream : std::uint64_t {
   kRankingStream = 0x72616e6bull,     // "rank"
 };
 
-void Shuffle(std::vector<int>* values, sim::Random* random) {
+void Shuffle(std::vector<int>* values, people::Random* random) {
   // Fisher-Yates with our own uniform index (std::shuffle's use of the engine is unspecified).
   for (int i = static_cast<int>(values->size()) - 1; i > 0; --i) {
     std::swap((*values)[i], (*values)[random->Index(i + 1)]);
@@ -88,7 +88,7 @@ ScoringDesign DrawScoringDesign(const ScorerOptions& options, int animators, int
   design.scorers = ScorerCount(options, animators, takes);
   const int c = options.comparisons_per_take;
   const int block = takes * c;  // one animator's comparisons
-  sim::Random random(sim::DeriveSeed(seed, {kDesignStream}));
+  people::Random random(people::DeriveSeed(seed, {kDesignStream}));
 
   // Slots: the animators in random order, each a block of K·c comparisons with every take c times
   // in random order. Dealing the slots round-robin to the scorers (in random order) gives scorer
@@ -166,12 +166,12 @@ std::string ScorerId(int scorer, int animators) {
 
 std::vector<ComparisonRow> JudgeComparisons(const ScoringDesign& design,
                                             const std::vector<AnimationAppeals>& appeals,
-                                            const sim::ViewerOptions& viewer, std::uint64_t seed) {
+                                            const people::ViewerOptions& viewer, std::uint64_t seed) {
   if (static_cast<int>(appeals.size()) != design.animators) {
     ThrowBadValue("appeals", std::to_string(appeals.size()) + " animators",
                   std::to_string(design.animators) + " as in the design");
   }
-  const std::uint64_t viewing_seed = sim::DeriveSeed(seed, {kViewingStream});
+  const std::uint64_t viewing_seed = people::DeriveSeed(seed, {kViewingStream});
   std::vector<ComparisonRow> rows;
   rows.reserve(design.comparisons.size());
   for (const Assignment& a : design.comparisons) {
@@ -180,14 +180,14 @@ std::vector<ComparisonRow> JudgeComparisons(const ScoringDesign& design,
       ThrowBadValue("design", "take " + std::to_string(a.take + 1),
                     "one of the animator's " + std::to_string(animations.takes.size()) + " takes");
     }
-    const sim::Viewer person = sim::DrawViewer(viewer, seed, a.scorer);
+    const people::Viewer person = people::DrawViewer(viewer, seed, a.scorer);
     // Each viewing has its own noise, keyed by who watches what.
     const auto key = [&](std::uint64_t item) {
-      return sim::DeriveSeed(viewing_seed, {static_cast<std::uint64_t>(a.scorer),
+      return people::DeriveSeed(viewing_seed, {static_cast<std::uint64_t>(a.scorer),
                                             static_cast<std::uint64_t>(a.animator), item});
     };
-    const double montage = sim::Utility(animations.montage, person, viewer, seed, key(0));
-    const double take = sim::Utility(animations.takes[a.take], person, viewer, seed,
+    const double montage = people::Utility(animations.montage, person, viewer, seed, key(0));
+    const double take = people::Utility(animations.takes[a.take], person, viewer, seed,
                                      key(static_cast<std::uint64_t>(a.take) + 1));
     rows.push_back({ScorerId(a.scorer, design.animators), AnimatorId(a.animator), a.take + 1,
                     montage > take, 0});
@@ -196,23 +196,23 @@ std::vector<ComparisonRow> JudgeComparisons(const ScoringDesign& design,
 }
 
 std::vector<RankingRow> RankOwnAnimations(const std::vector<AnimationAppeals>& appeals,
-                                          const sim::ViewerOptions& viewer,
-                                          const sim::SelfAppraisalOptions& self_appraisal,
+                                          const people::ViewerOptions& viewer,
+                                          const people::SelfAppraisalOptions& self_appraisal,
                                           std::uint64_t seed) {
-  const std::uint64_t ranking_seed = sim::DeriveSeed(seed, {kRankingStream});
+  const std::uint64_t ranking_seed = people::DeriveSeed(seed, {kRankingStream});
   std::vector<RankingRow> rows;
   for (int i = 0; i < static_cast<int>(appeals.size()); ++i) {
-    const sim::Viewer person = sim::DrawViewer(viewer, seed, i);
+    const people::Viewer person = people::DrawViewer(viewer, seed, i);
     const int takes = static_cast<int>(appeals[i].takes.size());
     // Items: takes 0..K-1, then the montage (K).
     std::vector<double> utility(takes + 1);
     for (int item = 0; item <= takes; ++item) {
-      const sim::Appeal& appeal = item < takes ? appeals[i].takes[item] : appeals[i].montage;
-      utility[item] = sim::Utility(
+      const people::Appeal& appeal = item < takes ? appeals[i].takes[item] : appeals[i].montage;
+      utility[item] = people::Utility(
           appeal, person, viewer, seed,
-          sim::DeriveSeed(ranking_seed,
+          people::DeriveSeed(ranking_seed,
                           {static_cast<std::uint64_t>(i), static_cast<std::uint64_t>(item)})) +
-          sim::SelfAppraisalBias(self_appraisal, item, takes);
+          people::SelfAppraisalBias(self_appraisal, item, takes);
     }
     std::vector<int> order(takes + 1);
     std::iota(order.begin(), order.end(), 0);

@@ -73,8 +73,8 @@ std::string ScorerId(int scorer, int animators);
 
 // What one animator's animations offer a viewer: takes in recording order, and the montage.
 struct AnimationAppeals {
-  std::vector<sim::Appeal> takes;
-  sim::Appeal montage;
+  std::vector<people::Appeal> takes;
+  people::Appeal montage;
 };
 
 // Each comparison judged by its scorer's simulated viewer (viewer index = scorer index): the
@@ -82,14 +82,14 @@ struct AnimationAppeals {
 // design.animators entries. Deterministic in `seed`.
 std::vector<ComparisonRow> JudgeComparisons(const ScoringDesign& design,
                                             const std::vector<AnimationAppeals>& appeals,
-                                            const sim::ViewerOptions& viewer, std::uint64_t seed);
+                                            const people::ViewerOptions& viewer, std::uint64_t seed);
 
 // Each animator ranks their own takes and montage by their utility in one viewing each plus the
 // self-appraisal biases (people/self_appraisal.h), 1 = the highest. Same viewers and seed as
 // JudgeComparisons.
 std::vector<RankingRow> RankOwnAnimations(const std::vector<AnimationAppeals>& appeals,
-                                          const sim::ViewerOptions& viewer,
-                                          const sim::SelfAppraisalOptions& self_appraisal,
+                                          const people::ViewerOptions& viewer,
+                                          const people::SelfAppraisalOptions& self_appraisal,
                                           std::uint64_t seed);
 
 }  // namespace mmh::study

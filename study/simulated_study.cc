@@ -38,15 +38,15 @@ AnimatorOutcome Summarise(const StudyConfig& config, int index, pipeline::Animat
     // latent quality.
     // (render.frames may shorten a recording: the quality of the recorded frames.)
     const std::vector<double>& quality = take.performed.quality.quality;
-    out.take_appeal.push_back(sim::Appraise(
+    out.take_appeal.push_back(people::Appraise(
         take.tracked,
         std::span<const double>(quality).first(std::min(quality.size(), take.tracked.size())),
         config.viewer));
   }
-  out.montage_appeal = sim::Appraise(run.montage.trajectory, run.montage_quality, config.viewer);
+  out.montage_appeal = people::Appraise(run.montage.trajectory, run.montage_quality, config.viewer);
   if (config.run.run.metrics) {
     out.truth_montage_appeal =
-        sim::Appraise(run.truth_montage.trajectory, run.truth_montage_quality, config.viewer);
+        people::Appraise(run.truth_montage.trajectory, run.truth_montage_quality, config.viewer);
   }
   for (const auto& segment : run.montage.segments) out.montage_takes.push_back(segment.take);
   out.montage_summary = run.montage.summary;
@@ -87,8 +87,8 @@ StudyConfig StudyConfig::FromConfig(const Config& config) {
   out.run = pipeline::RunConfig::FromConfig(config, {"study", "scorers", "viewer", "self_appraisal"});
   out.study = config.Get<SimulatedStudyOptions>("study");
   out.scorers = config.Get<ScorerOptions>("scorers");
-  out.viewer = config.Get<sim::ViewerOptions>("viewer");
-  out.self_appraisal = config.Get<sim::SelfAppraisalOptions>("self_appraisal");
+  out.viewer = config.Get<people::ViewerOptions>("viewer");
+  out.self_appraisal = config.Get<people::SelfAppraisalOptions>("self_appraisal");
   // Checked here so that a bad design fails before any animator runs.
   ScorerCount(out.scorers, out.study.animators, out.run.run.takes);
   return out;
@@ -108,8 +108,8 @@ StudyConfig StudyConfig::ForReplicate(int replicate) const {
   if (replicate == 0) return out;
   const auto r = static_cast<std::uint64_t>(replicate);
   out.run.render.population.seed =
-      sim::DeriveSeed(run.render.population.seed, {kReplicatePopulation, r});
-  out.study.seed = sim::DeriveSeed(study.seed, {kReplicateScoring, r});
+      people::DeriveSeed(run.render.population.seed, {kReplicatePopulation, r});
+  out.study.seed = people::DeriveSeed(study.seed, {kReplicateScoring, r});
   // Only replicate 0's animators are written out (results.json, animators.csv).
   out.run.run.metrics = false;
   return out;

@@ -63,8 +63,8 @@ struct StudyConfig {
   pipeline::RunConfig run;
   SimulatedStudyOptions study;
   ScorerOptions scorers;
-  sim::ViewerOptions viewer;
-  sim::SelfAppraisalOptions self_appraisal;
+  people::ViewerOptions viewer;
+  people::SelfAppraisalOptions self_appraisal;
 
   static StudyConfig FromConfig(const Config& config);
   nlohmann::json ToJson() const;
@@ -79,10 +79,10 @@ struct AnimatorOutcome {
   double skill = 0.0;                    // the animator's skill (before the practice)
   std::vector<double> take_skill;        // skill at each take
   std::vector<double> take_quality;      // mean latent quality of each take
-  std::vector<sim::Appeal> take_appeal;  // each tracked take as viewers see it
-  sim::Appeal montage_appeal;            // the montage of the tracked takes
+  std::vector<people::Appeal> take_appeal;  // each tracked take as viewers see it
+  people::Appeal montage_appeal;            // the montage of the tracked takes
   // The montage of the ground truth, for comparison (run.metrics only).
-  std::optional<sim::Appeal> truth_montage_appeal;
+  std::optional<people::Appeal> truth_montage_appeal;
   std::vector<int> montage_takes;        // take of each montage segment
   montage::ComposeSummary montage_summary;
   std::optional<pipeline::RunMetrics> metrics;  // the run's metrics.json (run.metrics only)

@@ -71,7 +71,7 @@ struct StudyDataOptions {
   void VisitFields(V& v) {
     v("allow_tied_ranks", allow_tied_ranks);
   }
-  void Validate(const std::string& prefix) const {}
+  void Validate(const std::string& /*prefix*/) const {}  // nothing to check
 };
 
 // Reads rankings.csv and comparisons.csv (required) and segment_costs.csv (optional) from `dir`,

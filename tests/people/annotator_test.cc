@@ -11,7 +11,7 @@
 #include "people/performance.h"
 #include "tests/test_util.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 using test_util::ErrorOf;
@@ -137,9 +137,9 @@ TEST(AnnotatorTest, BadInput) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 // The dead band h (intermittent control): the hand moves only when the opinion has left the
@@ -173,4 +173,4 @@ TEST(AnnotatorTest, MoveThresholdMakesTheBlockDwell) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -11,7 +11,7 @@
 #include "core/options.h"
 #include "tests/test_util.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 using test_util::ErrorOf;
@@ -207,4 +207,4 @@ TEST(PerformanceTest, LayeredTakesHaveTheMontagesLengthAndHitTheirMarkers) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -6,7 +6,7 @@
 #include "core/error.h"
 #include "tests/test_util.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 TEST(PopulationTest, ParticipantsAreReproducibleAndInRange) {
@@ -40,4 +40,4 @@ TEST(PopulationTest, BadOptionsNameTheField) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -5,7 +5,7 @@
 
 #include "tests/test_util.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 using test_util::ErrorOf;
@@ -35,4 +35,4 @@ TEST(SelfAppraisalTest, BadValuesAreErrors) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "tests/test_util.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 using test_util::ErrorOf;
@@ -117,4 +117,4 @@ TEST(StoryTest, BadStoriesNameTheFileAndTheBeat) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people

@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "tests/test_util.h"
 
-namespace mmh::sim {
+namespace mmh::people {
 namespace {
 
 using test_util::ErrorOf;
@@ -96,4 +96,4 @@ TEST(ViewerTest, CompositeQualityAndBadInput) {
 }
 
 }  // namespace
-}  // namespace mmh::sim
+}  // namespace mmh::people

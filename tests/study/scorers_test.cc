@@ -99,8 +99,8 @@ TEST(ScorersTest, ImpossibleDesignsAreInputErrors) {
   EXPECT_THROW(ScorerCount(ScorerOptions{}, 1, 3), InputError);
 }
 
-sim::Appeal AppealOf(double quality, double artefacts_per_minute = 0) {
-  sim::Appeal a;
+people::Appeal AppealOf(double quality, double artefacts_per_minute = 0) {
+  people::Appeal a;
   a.mean_quality = quality;
   a.artefacts_per_minute = artefacts_per_minute;
   a.appeal = quality - 0.025 * artefacts_per_minute;
@@ -110,7 +110,7 @@ sim::Appeal AppealOf(double quality, double artefacts_per_minute = 0) {
 TEST(ScorersTest, ViewersPreferTheBetterAnimation) {
   const ScorerOptions options;
   const ScoringDesign design = DrawScoringDesign(options, 20, 3, 11);
-  sim::ViewerOptions viewer;
+  people::ViewerOptions viewer;
   viewer.judgement_noise = 0.05;  // the hand-set σ: differences of 0.3 always decide
   // Montage clearly better (0.3 quality above the takes; noise sd 0.05): it wins every time.
   std::vector<AnimationAppeals> better(20);
@@ -140,13 +140,13 @@ TEST(ScorersTest, ViewersPreferTheBetterAnimation) {
   EXPECT_TRUE(scorers.count("A01") && scorers.count("A20") && scorers.count("S22"));
 }
 
-sim::ViewerOptions PreciseViewer() {
-  sim::ViewerOptions viewer;
+people::ViewerOptions PreciseViewer() {
+  people::ViewerOptions viewer;
   viewer.judgement_noise = 0.05;
   return viewer;
 }
 
-sim::SelfAppraisalOptions Unbiased() { return {.progress_weight = 0, .choice_bonus = 0}; }
+people::SelfAppraisalOptions Unbiased() { return {.progress_weight = 0, .choice_bonus = 0}; }
 
 TEST(ScorersTest, RankingsArePermutationsFollowingUtility) {
   std::vector<AnimationAppeals> appeals(5);
@@ -176,7 +176,7 @@ TEST(ScorersTest, SelfAppraisalBiasesTheAnimatorsOnly) {
     a.takes = {AppealOf(0.8), AppealOf(0.7), AppealOf(0.6)};
     a.montage = AppealOf(0.5);
   }
-  sim::SelfAppraisalOptions biased;
+  people::SelfAppraisalOptions biased;
   biased.progress_weight = 1.0;  // far larger than the differences: recording order decides
   biased.choice_bonus = 0.5;
   for (const auto& row : RankOwnAnimations(appeals, PreciseViewer(), biased, 1)) {

@@ -242,7 +242,7 @@ TEST(SimulatedStudyTest, FastFidelityAgreesWithFullFidelity) {
   // The montages show the same quality of performance within 0.1 (the montage from tracked data
   // picks by read annotations in both modes).
   const auto quality = [](const pipeline::AnimatorRun& run, const StudyConfig& c) {
-    return sim::Appraise(run.montage.trajectory, run.montage_quality, c.viewer).mean_quality;
+    return people::Appraise(run.montage.trajectory, run.montage_quality, c.viewer).mean_quality;
   };
   EXPECT_NEAR(quality(full, full_config), quality(fast, fast_config), 0.1);
 }

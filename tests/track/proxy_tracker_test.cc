@@ -160,7 +160,7 @@ TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
 }
 
 // Takes of the Soldier story (configs/study_soldier.json: the castle props) performed by four
-// simulated animators (sim::PerformTake; other participants than the ones used while tuning the
+// simulated animators (people::PerformTake; other participants than the ones used while tuning the
 // tracker, animators 0 and 3): the first 200 frames of each (marching in front of the castle,
 // turning, the hand on the figure's head). Thresholds: the median translation (2 mm) and
 // every loss recovered within 15 frames; the median rotation and the share within 5 deg and 1 cm

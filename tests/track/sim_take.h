@@ -75,7 +75,7 @@ class SimTake {
 // A session of the Soldier story (configs/study_soldier.json: the castle props, the study's
 // population) as `mmh render --config configs/study_soldier.json --set render.animator=A
 // --set render.take=K --set render.session=...` renders it: participant `animator` performs take
-// `take` of the Soldier (sim::PerformTake); a recording session moves the proxy along the performed
+// `take` of the Soldier (people::PerformTake); a recording session moves the proxy along the performed
 // take with the hand on it, an annotation session rests the proxy beside the play area and moves
 // the slider block as the participant annotates the take. *frames: the take's length.
 // `source` is the project's folder (MMH_SOURCE_DIR).
@@ -90,7 +90,7 @@ inline SimTake SoldierStorySession(const std::string& source, int animator, int 
   config.render.take = take;
   config.render.session = session;
   const sim::StoryScript script(config, config.render.story, 0, animator);
-  auto performed = std::make_shared<const sim::PerformedTake>(script.Perform(take));
+  auto performed = std::make_shared<const people::PerformedTake>(script.Perform(take));
   config.render.proxy = script.ProxyFile();
   *frames = performed->frames();
   const double rate = config.sensor.frame_rate;
