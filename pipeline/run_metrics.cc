@@ -234,8 +234,9 @@ nlohmann::json ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run
   j["scenario"] = {
       {"story", render.render.story},          {"object", render.render.object},
       {"animator", run.participant.index},     {"takes", static_cast<int>(run.takes.size())},
-      {"practice", config.run.practice},       {"fidelity", EnumName(config.run.fidelity)},
-      {"rendered_frames", run.rendered_frames}};
+      {"practice", config.run.practice},       {"fidelity", EnumName(config.run.fidelity)}};
+  // (Not rendered_frames: it counts the work of this process, 0 for takes that --resume loaded,
+  // so it is in run.json's "seconds" with the timings; metrics.json is a function of the config.)
 
   // The proxy's metric points (ADD/ADD-S), from the model the sensor rendered.
   const auto points = metrics::MetricPoints(proxy_model);
