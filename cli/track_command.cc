@@ -17,6 +17,7 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/mesh_io.h"
+#include "core/staged_folder.h"
 #include "core/tum_io.h"
 #include "track/frame_source.h"
 #include "track/recording.h"
@@ -126,6 +127,11 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                         : std::nullopt);
   }
 
+  // The outputs are written into a staging folder beside --out and moved into place whole (a
+  // kill or a failure leaves no partial --out); an --out that mmh did not write is refused here,
+  // before the work.
+  const fs::path out = args.common.out_dir;
+  StagedFolder staged(out);
   const bool bar = ShowProgress(args.common);
   const track::TrackRun run = track::RunTracking(*source, model, args.model, setup, calibrated,
                                                  track_config, [&](int done, int total) {
@@ -138,23 +144,28 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
                                                  FirstTruePose(truth, track_config.track));
   if (bar) std::cerr << '\n';
 
-  const fs::path out = args.common.out_dir;
-  std::vector<std::string> written = track::WriteTrackRun(out, run, track_config);
+  if (run.summary.frames == 0) {
+    throw InputError("--input " + args.input + ": the source delivered no frame");
+  }
+  const fs::path& stage = staged.staging();
+  std::vector<std::string> written = track::WriteTrackRun(stage, run, track_config);
   const nlohmann::json resolved = track_config.ToJson();
   nlohmann::json timings = run.summary.ToJson();
   timings["input"] = source->Describe();
   timings["setup"] =
       setup_file.empty() ? "none (table frame from the estimated plane)" : setup_file;
-  WriteFileAtomically(out / "config.resolved.json", resolved.dump(2) + "\n");
-  WriteFileAtomically(out / "run.json",
+  WriteFileAtomically(stage / "config.resolved.json", resolved.dump(2) + "\n");
+  WriteFileAtomically(stage / "run.json",
                       Provenance(argv, resolved, args.common.threads, timings).dump(2) + "\n");
   if (truth) {
-    WriteTum(out / "groundtruth.tum", *truth,
+    WriteTum(stage / "groundtruth.tum", *truth,
              "camera_T_object of the followed object, from the recording's ground truth");
     written.push_back("groundtruth.tum");
   }
   written.push_back("config.resolved.json");
   written.push_back("run.json");
+  // Committed even when nothing was tracked below: status.csv says why, and is the result.
+  staged.Commit();
   if (!args.common.quiet) {
     const track::TrackSummary& s = run.summary;
     std::cout << "track: " << s.frames << " frames from " << source->Describe() << ": ";
@@ -173,9 +184,6 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
     std::cout << "written: " << out.string() << "/{";
     for (size_t i = 0; i < written.size(); ++i) std::cout << (i ? ", " : "") << written[i];
     std::cout << "}\n";
-  }
-  if (run.summary.frames == 0) {
-    throw InputError("--input " + args.input + ": the source delivered no frame");
   }
   if (!track_config.track.proxy) {
     if (run.summary.slider_found == 0) {

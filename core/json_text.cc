@@ -5,6 +5,7 @@
 
 #include "core/error.h"
 #include "core/error_text.h"
+#include "core/text_parsing.h"
 
 namespace mmh {
 namespace {
@@ -87,6 +88,10 @@ nlohmann::json ParseJsonText(std::string_view text, const std::string& source) {
     throw InputError(source + ":" + std::to_string(line) + ":" + std::to_string(column) +
                      ": invalid JSON (" + EscapeForMessage(e.what(), 200) + ")");
   }
+}
+
+nlohmann::json ReadJsonFile(const std::filesystem::path& path) {
+  return ParseJsonText(ReadTextFile(path, kMaxJsonFileBytes), path.string());
 }
 
 }  // namespace mmh

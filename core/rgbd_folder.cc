@@ -94,10 +94,6 @@ PinholeIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::stri
   return intrinsics;
 }
 
-nlohmann::json ReadJsonFile(const fs::path& path) {
-  return ParseJsonText(ReadTextFile(path, kMaxJsonFileBytes), path.string());
-}
-
 // camera.json -> camera info; `extra` receives the "extra" object.
 RgbdCameraInfo CameraInfoFromJson(const fs::path& path, nlohmann::json* extra) {
   const nlohmann::json json = ReadJsonFile(path);

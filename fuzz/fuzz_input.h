@@ -10,10 +10,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 
 #include "core/error.h"
+#include "core/image_io.h"
 
 namespace mmh::fuzz {
 
@@ -54,6 +56,38 @@ inline std::pair<std::string_view, std::string_view> SplitInput(std::string_view
   const std::size_t at = data.find(separator);
   if (at == std::string_view::npos) return {data, {}};
   return {data.substr(0, at), data.substr(at + separator.size())};
+}
+
+// For targets that read several files of one folder: splits `data` at "\n----\n" into one part
+// per name, in order, and writes each non-empty part to ScratchDir()/folder/name (a file whose part
+// is empty or missing is removed, so the reader sees it absent).
+inline void WriteParts(std::string_view data, const std::string& folder,
+                       std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    const auto [part, tail] = SplitInput(data, "\n----\n");
+    std::filesystem::remove(ScratchDir() / folder / name);
+    if (!part.empty()) WriteInput(folder + "/" + name, part);
+    data = tail;
+  }
+}
+
+// Writes a small valid frame (4 x 3 px, 16-bit depth 5000 and grey colour PNGs) as
+// folder/depth/STEM.png and folder/rgb/STEM.png for each stem, so that readers of a folder's
+// index get as far as reading its images.
+inline void WriteTinyFrames(const std::filesystem::path& folder,
+                            std::initializer_list<const char*> stems) {
+  std::filesystem::create_directories(folder / "rgb");
+  std::filesystem::create_directories(folder / "depth");
+  DepthImage depth;
+  depth.width = 4, depth.height = 3;
+  depth.values.assign(12, 5000);
+  RgbImage rgb;
+  rgb.width = 4, rgb.height = 3;
+  rgb.rgb.assign(36, 128);
+  for (const char* stem : stems) {
+    WriteDepthPng16(folder / "depth" / (std::string(stem) + ".png"), depth);
+    WriteRgbPng(folder / "rgb" / (std::string(stem) + ".png"), rgb);
+  }
 }
 
 }  // namespace mmh::fuzz

@@ -5,6 +5,9 @@
 # leaves its input in fuzz/findings/TARGET/: fix it, then commit the input to
 # fuzz/regressions/TARGET/ (the test suite replays it).
 #   fuzz/run.sh [SECONDS] [TARGET...]
+# MMH_FUZZ_TIMEOUT (seconds, default 1): the time one input may take. libFuzzer measures it on the
+# wall clock, so on a machine loaded far beyond its cores a starved process can exceed 1 s on an
+# input that takes milliseconds (replay a timeout alone to tell): raise it there.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-30}"
@@ -12,7 +15,8 @@ shift || true
 build_dir="${MMH_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 targets=("$@")
 if [[ ${#targets[@]} -eq 0 ]]; then
-  targets=(tum annotation_csv config_json mesh image rgbd_folder)
+  # every target: fuzz/TARGET_fuzzer.cc
+  for f in "$root"/fuzz/*_fuzzer.cc; do t="${f##*/}"; targets+=("${t%_fuzzer.cc}"); done
 fi
 if [[ ! -f "$build_dir/CMakeCache.txt" ]]; then
   cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
@@ -29,8 +33,10 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "$findings"
   cp -n "$root/fuzz/corpus/$t/"* "$work/" 2>/dev/null || true
   echo "fuzz: $t for ${seconds} s"
+  # (The LeakSanitizer suppressions name third-party libraries only: tools/sanitizer/lsan.supp.)
   if ! UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-      "$build_dir/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 \
+      LSAN_OPTIONS="suppressions=$root/tools/sanitizer/lsan.supp:print_suppressions=0" \
+      "$build_dir/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout="${MMH_FUZZ_TIMEOUT:-1}" -rss_limit_mb=2048 \
       -max_len=65536 -print_final_stats=1 -artifact_prefix="$findings/" "$work" \
       "$root/fuzz/regressions/$t" 2>"$build_dir/fuzz-$t.log"; then
     echo "fuzz: $t FOUND a problem: see $build_dir/fuzz-$t.log and $findings/" >&2

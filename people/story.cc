@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/options.h"
 #include "core/text_parsing.h"
 
@@ -309,12 +310,7 @@ int Story::ObjectIndex(const std::string& name) const {
 }
 
 Story ParseStory(const std::string& text, const std::string& file, const TableSetup& table) {
-  nlohmann::json json;
-  try {
-    json = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(file + ": not valid JSON: " + e.what());
-  }
+  const nlohmann::json json = ParseJsonText(text, file);
   if (!json.is_object()) ThrowBadValue(file, "not an object", "a story object");
   RequireKnownKeys(json, {"name", "script", "objects"}, file);
   Story story;

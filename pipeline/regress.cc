@@ -55,14 +55,7 @@ void MetricTolerance::Validate(const std::string& prefix) const {
 Baseline ReadBaseline(const std::filesystem::path& folder) {
   Baseline b;
   b.file = folder / "baseline.json";
-  std::ifstream in(b.file);
-  if (!in) ThrowBadValue(b.file.string(), "a missing or unreadable file", "a baseline.json");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    ThrowBadValue(b.file.string(), std::string("invalid JSON (") + e.what() + ")", "a JSON object");
-  }
+  const nlohmann::json j = ReadJsonFile(b.file);
   const std::string file = b.file.string();
   if (!j.is_object()) ThrowBadValue(file, j.dump().substr(0, 40), "a JSON object");
   RequireOnlyKeys(j, {"root", "scenarios", "comment"}, file);
@@ -94,7 +87,12 @@ Baseline ReadBaseline(const std::filesystem::path& folder) {
         scenario.sets.push_back(set.get<std::string>());
       }
     }
-    if (s.contains("config_hash")) scenario.config_hash = s["config_hash"].get<std::string>();
+    if (s.contains("config_hash")) {
+      if (!s["config_hash"].is_string()) {
+        ThrowBadValue(where + ".config_hash", s["config_hash"].dump(), "a hash string");
+      }
+      scenario.config_hash = s["config_hash"].get<std::string>();
+    }
     const nlohmann::json& metrics = Require(s, "metrics", where);
     // Empty for a new scenario: `mmh regress --update` fills it in.
     if (!metrics.is_object()) {

@@ -282,7 +282,8 @@ RunMetrics ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run,
   m.scenario.takes = static_cast<int>(run.takes.size());
   m.scenario.practice = config.run.practice;
   m.scenario.fidelity = EnumName(config.run.fidelity);
-  m.scenario.rendered_frames = run.rendered_frames;
+  // (Not rendered_frames: it counts the work of this process, 0 for takes that --resume loaded,
+  // so it is in run.json's "seconds" with the timings; metrics.json is a function of the config.)
 
   // The proxy's metric points (ADD/ADD-S), from the model the sensor rendered.
   const auto points = metrics::MetricPoints(proxy_model);
@@ -368,8 +369,7 @@ nlohmann::json ToJson(const RunMetrics& m) {
                    {"animator", m.scenario.animator},
                    {"takes", m.scenario.takes},
                    {"practice", m.scenario.practice},
-                   {"fidelity", m.scenario.fidelity},
-                   {"rendered_frames", m.scenario.rendered_frames}};
+                   {"fidelity", m.scenario.fidelity}};
   nlohmann::json takes = nlohmann::json::array();
   for (const TakeMetrics& t : m.takes) {
     takes.push_back({{"take", t.take},

@@ -127,7 +127,6 @@ struct RunMetrics {
     int takes = 0;
     std::string practice;
     std::string fidelity;
-    int rendered_frames = 0;
   } scenario;
   std::vector<TakeMetrics> takes;
   std::optional<PracticeMetrics> practice;

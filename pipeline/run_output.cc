@@ -6,6 +6,7 @@
 #include "core/annotation.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/text_parsing.h"
 #include "core/tum_io.h"
 #include "metrics/tracking_metrics.h"
@@ -107,9 +108,13 @@ bool LoadTakeRun(const std::filesystem::path& out, TakeRun& take, bool practice)
                       " (stage outputs inconsistent with this run: run without --resume "
                       "or into a new folder)");
   };
-  const nlohmann::json session =
-      nlohmann::json::parse(ReadTextFile(dir / "session.json"), nullptr, false);
-  if (session.is_discarded() || !session.is_object() || !session.contains("frames")) {
+  nlohmann::json session;
+  try {
+    session = ReadJsonFile(dir / "session.json");
+  } catch (const InputError&) {
+    inconsistent("session.json", "unreadable", "the session summary mmh run writes");
+  }
+  if (!session.is_object() || !session.contains("frames")) {
     inconsistent("session.json", "unreadable", "the session summary mmh run writes");
   }
   if (session["frames"] != frames) {

@@ -12,6 +12,10 @@
 namespace mmh::track {
 namespace {
 
+// Most elements one array may have: a level-5 element's size is a uint32 (bytes), so a binary
+// file cannot hold more; the text export is held to the same.
+constexpr int64_t kMaxMatElements = int64_t{1} << 32;
+
 // Data types of the tags (MAT-File Format, table 1-1) and array classes (table 1-3).
 enum MatType : uint32_t {
   kMiInt8 = 1,
@@ -156,6 +160,9 @@ void ParseMatrix(const Element& matrix, const std::string& where, size_t base, M
     std::memcpy(&d, dims_element.data + 4 * i, 4);
     if (d < 0) r.Fail("a negative dimension");
     array.dims.push_back(d);
+    // An element's size is a uint32, so more elements than kMaxMatElements cannot be stored; the
+    // check also keeps the product from overflowing (found by fuzz/mat_fuzzer.cc).
+    if (d != 0 && count > kMaxMatElements / d) r.Fail("dimensions of more than 2^32 elements");
     count *= d;
   }
   const Element name_element = r.Next();
@@ -316,7 +323,14 @@ MatFile ReadMatText(const std::filesystem::path& path) {
                          current_name + "' without dimensions (expected 'name: d1 d2 ...')");
       }
       expected = 1;
-      for (int64_t d : array.dims) expected *= static_cast<size_t>(d);
+      for (int64_t d : array.dims) {
+        if (d != 0 && static_cast<int64_t>(expected) > kMaxMatElements / d) {
+          ThrowBadValue(path.string() + ":" + std::to_string(line_number) + ": dimensions of '" +
+                            current_name + "'",
+                        line.substr(colon + 1), "at most 2^32 elements");
+        }
+        expected *= static_cast<size_t>(d);
+      }
       file.arrays[current_name] = std::move(array);
       current = &file.arrays[current_name];
       header_line = line_number;

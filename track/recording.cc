@@ -3,12 +3,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/json_text.h"
 #include "track/mat_file.h"
 
 namespace mmh::track {
@@ -24,16 +24,6 @@ constexpr const char* kYcbDepthSuffix = "-depth.png";
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-nlohmann::json ReadJson(const fs::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string() + ": cannot open");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path.string() + ": not valid JSON (" + e.what() + ")");
-  }
 }
 
 // `count` finite numbers under `key` of `object`; InputError naming `where` and the key otherwise.
@@ -157,12 +147,12 @@ void RecordingFrameSource::ReadBop() {
   if (!fs::exists(gt_file)) {
     throw InputError(gt_file.string() + " is missing (the per-image ground-truth poses)");
   }
-  const nlohmann::json cameras = ReadJson(camera_file);
-  const nlohmann::json gts = ReadJson(gt_file);
+  const nlohmann::json cameras = ReadJsonFile(camera_file);
+  const nlohmann::json gts = ReadJsonFile(gt_file);
   if (!cameras.is_object()) ThrowBadValue(camera_file.string(), "not an object", "{\"<im_id>\": {...}}");
   if (!gts.is_object()) ThrowBadValue(gt_file.string(), "not an object", "{\"<im_id>\": [...]}");
   std::optional<nlohmann::json> infos;
-  if (fs::exists(info_file)) infos = ReadJson(info_file);
+  if (fs::exists(info_file)) infos = ReadJsonFile(info_file);
 
   std::map<int, std::string> ids;  // im_id -> key, sorted by im_id
   for (const auto& [key, value] : cameras.items()) ids[ImageId(key, camera_file)] = key;

@@ -1,11 +1,10 @@
 #include "track/setup.h"
 
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "core/error.h"
+#include "core/json_text.h"
 
 namespace mmh::track {
 namespace {
@@ -52,14 +51,7 @@ void TrackSetup::Validate(const std::string& where) const {
 
 TrackSetup ReadSetupJson(const std::filesystem::path& path) {
   const std::string where = path.string();
-  std::ifstream in(path);
-  if (!in) throw InputError(where + ": cannot open the setup calibration file");
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(where + ": not valid JSON (" + e.what() + ")");
-  }
+  const nlohmann::json root = ReadJsonFile(path);
   if (!root.is_object()) ThrowBadValue(where, root.dump(), "a JSON object");
   TrackSetup setup;
   if (root.contains("camera_T_table")) {

@@ -579,6 +579,10 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
       {"render: story missing",
        "render --set render.story=/nonexistent/story.json --out {OUT}",
        {"/nonexistent/story.json"}},
+      {"render: story with a repeated key",
+       "render --set render.story={D}/s.json --out {OUT}",
+       {"s.json: key 'objects[0].name'", "appears twice"},
+       {{"s.json", R"({"name": "x", "objects": [{"name": "a", "name": "b"}]})"}}},
 
       // ---- track (RGB-D folders, meshes, camera.json) ------------------------------------------
       {"track: input missing",
@@ -706,6 +710,13 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
        "regress --baseline {D}/b --out {OUT}",
        {"baseline.json"},
        {{"b/baseline.json", "{\"scenarios\": [}"}}},
+      // (A config_hash of another type used to escape as nlohmann's type_error: exit 1.)
+      {"regress: config_hash not a string",
+       "regress --baseline {D}/b --out {OUT}",
+       {"b/baseline.json: scenarios[0].config_hash", "7", "a hash string"},
+       {{"b/baseline.json",
+         R"({"root": ".", "scenarios": [{"name": "a", "config": "c.json", "config_hash": 7,)"
+         R"( "metrics": {}}]})"}}},
       {"sensor-check: data missing", "sensor-check --data {D}/none --out {OUT}", {"none"}},
   };
 

@@ -160,6 +160,24 @@ TEST(ImageIoTest, TruncatedPngIsAnInputErrorNotACrash) {
   EXPECT_THAT(ErrorOf([&] { ReadRgbImage(dir / "empty.png"); }), HasSubstr("empty.png"));
 }
 
+// Damaged compressed data (a flipped byte inside IDAT): the chunk's CRC names it before libpng,
+// which would print its own complaint to stderr even under --quiet, reads the file.
+TEST(ImageIoTest, DamagedPngDataFailsItsCrcWithoutLibpngPrinting) {
+  TempDir dir;
+  WriteDepthPng16(dir / "full.png", RandomDepth(64, 48, 5));
+  std::string bytes = ReadBytes(dir / "full.png");
+  const std::size_t idat = bytes.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  bytes[idat + 20] = static_cast<char>(bytes[idat + 20] ^ 0x5A);
+  WriteBytes(dir / "flipped.png", bytes);
+  testing::internal::CaptureStderr();
+  const std::string message = ErrorOf([&] { ReadDepthPng16(dir / "flipped.png"); });
+  const std::string printed = testing::internal::GetCapturedStderr();
+  EXPECT_THAT(message, HasSubstr("flipped.png: got a corrupt PNG (chunk 'IDAT' at byte "));
+  EXPECT_THAT(message, HasSubstr("fails its CRC"));
+  EXPECT_EQ(printed, "");
+}
+
 TEST(ImageIoTest, WrongChannelsOrBitDepthForDepthIsAnInputError) {
   TempDir dir;
   WriteWithOiio<uint8_t>(dir / "eight.png", 2, 2, 1, OIIO::TypeDesc::UINT8, {1, 2, 3, 4});

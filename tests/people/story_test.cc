@@ -110,7 +110,7 @@ TEST(StoryTest, BadStoriesNameTheFileAndTheBeat) {
     ParseStory(StoryWith(R"({"kind": "hit", "start": 0, "to": 1, "target": "ghost"})"), "s.json");
   });
   EXPECT_NE(bad_target.find("\"ghost\""), std::string::npos) << bad_target;
-  EXPECT_NE(ErrorOf([] { ParseStory("{", "s.json"); }).find("s.json: not valid JSON"),
+  EXPECT_NE(ErrorOf([] { ParseStory("{", "s.json"); }).find("s.json:1:2: invalid JSON"),
             std::string::npos);
   EXPECT_NE(ErrorOf([] { LoadStory("/nonexistent/story.json"); }).find("/nonexistent/story.json"),
             std::string::npos);

@@ -128,6 +128,18 @@ TEST(MatFileTest, DamagedFilesAreInputErrorsNamingTheFile) {
   for (size_t i = 200; i < 400; ++i) corrupt[i] = static_cast<char>(i);
   WriteText(dir / "corrupt.mat", corrupt);
   EXPECT_THAT(ErrorOf([&] { ReadMatFile(dir / "corrupt.mat"); }), HasSubstr("corrupt.mat"));
+  // Dimensions whose product no element could hold (and that would overflow a 64-bit count with
+  // a third one) are refused before any value is read.
+  std::string huge = TinyMatFile("abc");
+  const int32_t side = 2147483647;
+  std::memcpy(&huge[160], &side, 4);
+  std::memcpy(&huge[164], &side, 4);
+  WriteText(dir / "huge.mat", huge);
+  EXPECT_THAT(ErrorOf([&] { ReadMatFile(dir / "huge.mat"); }),
+              HasSubstr("dimensions of more than 2^32 elements"));
+  WriteText(dir / "huge.txt", "poses: 4294967296 4294967296 4294967296\n1\n");
+  EXPECT_THAT(ErrorOf([&] { ReadMatText(dir / "huge.txt"); }),
+              HasSubstr("huge.txt:1: dimensions of 'poses'"));
   WriteText(dir / "text.mat", "hello");
   EXPECT_THAT(ErrorOf([&] { ReadMatFile(dir / "text.mat"); }),
               HasSubstr("text.mat: not a level-5 MAT-file"));

@@ -47,8 +47,9 @@ TEST(SetupTest, BadFilesNameTheKey) {
                                 kTable + "}");
   EXPECT_THAT(ErrorOf([&] { ReadSetupJson(dir / "c.json"); }), HasSubstr("unit quaternion"));
   WriteText(dir / "d.json", "{\"table\": ");
-  EXPECT_THAT(ErrorOf([&] { ReadSetupJson(dir / "d.json"); }), HasSubstr("not valid JSON"));
-  EXPECT_THAT(ErrorOf([&] { ReadSetupJson(dir / "none.json"); }), HasSubstr("cannot open"));
+  EXPECT_THAT(ErrorOf([&] { ReadSetupJson(dir / "d.json"); }), HasSubstr("invalid JSON"));
+  EXPECT_THAT(ErrorOf([&] { ReadSetupJson(dir / "none.json"); }),
+              HasSubstr("none.json: got a path that does not exist"));
   WriteText(dir / "e.json",
             R"({"table": {"play_area_width": 0.5, "play_area_depth": 0.3, "like_box_center_x": 0.36,
        "like_box_center_y": -0.05, "like_box_length": 0.02, "like_box_width": 0.06}})");

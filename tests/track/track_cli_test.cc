@@ -87,6 +87,19 @@ TEST(TrackCliTest, TracksARenderedTakeFromItsFolder) {
                            "config.resolved.json"}) {
     EXPECT_EQ(ReadBytes(dir / "out" / name), ReadBytes(dir / "again" / name)) << name;
   }
+  // The outputs were staged beside --out and moved into place whole: no staging folder is left.
+  for (const auto& e : fs::directory_iterator(dir.path())) {
+    EXPECT_EQ(e.path().filename().string().find(".partial-"), std::string::npos) << e.path();
+  }
+  // A folder that mmh did not write is refused before the work, and left as it was.
+  fs::create_directories(dir / "theirs");
+  test_util::WriteText(dir / "theirs" / "notes.txt", "mine");
+  const auto theirs = RunMmh("track --quiet --input " + take.string() + " --model " +
+                             (take / "model.ply").string() + " --out " + (dir / "theirs").string());
+  EXPECT_EQ(theirs.exit_code, 2) << theirs.output;
+  EXPECT_THAT(theirs.output, HasSubstr("theirs"));
+  EXPECT_EQ(ReadBytes(dir / "theirs" / "notes.txt"), "mine");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / "theirs"), fs::directory_iterator()), 1);
 }
 
 // An annotation session (the proxy rests outside the play area, the hand moves the slider block):
