@@ -51,7 +51,7 @@ TEST(FrameSourceTest, CallbackStreamEndsWhenTheProducerSaysSo) {
   EXPECT_EQ(count, 3);
   EXPECT_EQ(source.Describe(), "simulator");
   // With a known length the source stops there.
-  CallbackFrameSource bounded([&](int i, RgbdFrame* f) { return true; }, "x", 2);
+  CallbackFrameSource bounded([&](int, RgbdFrame*) { return true; }, "x", 2);
   EXPECT_TRUE(bounded.Next(&frame));
   EXPECT_TRUE(bounded.Next(&frame));
   EXPECT_FALSE(bounded.Next(&frame));

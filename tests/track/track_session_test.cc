@@ -65,7 +65,7 @@ TEST(TrackSessionTest, SliderOnlyModeReadsAnAnnotationSession) {
 
 TEST(TrackSessionTest, SliderOnlyModeNeedsALikeBoxAndTheSlider) {
   test_take::SimTake take;
-  CallbackFrameSource source([&](int i, RgbdFrame* frame) { return false; }, "none", 0);
+  CallbackFrameSource source([&](int, RgbdFrame*) { return false; }, "none", 0);
   TrackConfig config;
   config.track.proxy = false;
   EXPECT_THAT(
