@@ -19,7 +19,7 @@
 #include "core/tum_io.h"
 #include "metrics/pose_evaluation.h"
 #include "track/recording.h"
-#include "track/track_session.h"
+#include "track/track_section.h"
 
 namespace mmh::cli {
 namespace {

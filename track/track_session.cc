@@ -36,14 +36,6 @@ void TrackOptions::Validate(const std::string& prefix) const {
   }
 }
 
-void RefuseRunSection(const Config& config) {
-  if (config.root().contains("run")) {
-    ThrowBadValue("run", "a section of an mmh track or mmh eval config",
-                  "its keys in the section \"track\" (\"run\" is mmh run's section: "
-                  "rename it, e.g. --set track.object=1)");
-  }
-}
-
 TrackConfig TrackConfig::FromConfig(const Config& config) {
   RefuseRunSection(config);
   config.RequireOnlySections({"track", "tracker", "slider", "freenect"});

@@ -21,6 +21,7 @@
 #include "track/proxy_tracker.h"
 #include "track/setup.h"
 #include "track/slider_reader.h"
+#include "track/track_section.h"
 
 namespace mmh::track {
 
@@ -87,10 +88,6 @@ struct TrackOptions {
   }
   void Validate(const std::string& prefix) const;
 };
-
-// mmh track's and mmh eval's config: refuses a section "run" (what "track" was called before
-// 2026-11; "run" is mmh run's section) with the hint to rename it.
-void RefuseRunSection(const Config& config);
 
 // Every section of a track config: "track", "tracker", "slider", "freenect".
 struct TrackConfig {
