@@ -12,7 +12,6 @@
 #include "cli/provenance.h"
 #include "core/config.h"
 #include "core/json_text.h"
-#include "core/text_parsing.h"
 #include "study/study_folder.h"
 
 namespace mmh::cli {
@@ -35,8 +34,7 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
   if (args.replicates > 0) config.Set("study.replicates=" + std::to_string(args.replicates));
   const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
   study_config.study.Validate("study");
-  const nlohmann::json paper =
-      ParseJsonText(ReadTextFile(args.paper_reported, kMaxJsonFileBytes), args.paper_reported);
+  const nlohmann::json paper = ReadJsonFile(args.paper_reported);
   const auto threads = LimitThreads(args.common.threads);
 
   // Everything is computed before anything is written: bad input or a failed run leaves no output.

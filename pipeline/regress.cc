@@ -306,8 +306,7 @@ void WriteBaseline(const Baseline& baseline, const std::vector<Scenario>& update
     j["config"] = std::filesystem::relative(s.config, baseline.root).string();
     scenarios.push_back(j);
   }
-  nlohmann::json file = ParseJsonText(ReadTextFile(baseline.file, kMaxJsonFileBytes),
-                                      baseline.file.string());
+  nlohmann::json file = ReadJsonFile(baseline.file);
   file["scenarios"] = scenarios;
   WriteFileAtomically(baseline.file, file.dump(2) + "\n");
 }

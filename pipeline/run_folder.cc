@@ -7,7 +7,6 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/json_text.h"
-#include "core/text_parsing.h"
 #include "pipeline/run_metrics.h"
 #include "pipeline/run_output.h"
 
@@ -19,7 +18,7 @@ void CheckResumable(const std::filesystem::path& out, const nlohmann::json& reso
     ThrowBadValue(file.string(), "missing",
                   "the resolved config of an earlier run in this folder (--resume continues one)");
   }
-  nlohmann::json earlier = ParseJsonText(ReadTextFile(file, kMaxJsonFileBytes), file.string());
+  nlohmann::json earlier = ReadJsonFile(file);
   if (!earlier.is_object()) {
     ThrowBadValue(file.string(), earlier.dump().substr(0, 40), "the resolved config mmh run writes");
   }
