@@ -21,7 +21,7 @@ using namespace mmh;
 
 pipeline::RunConfig SoldierConfig(const std::string& fidelity, int frames) {
   Config config = Config::Load(std::string(MMH_BENCH_SOURCE_DIR) + "/configs/soldier.json");
-  config.Set(std::string("render.story=\"") + MMH_BENCH_SOURCE_DIR +
+  config.Set(std::string("scenario.story=\"") + MMH_BENCH_SOURCE_DIR +
              "/configs/stories/soldier.json\"");
   config.Set("run.fidelity=" + fidelity);
   config.Set("render.frames=" + std::to_string(frames));
@@ -38,7 +38,7 @@ void BM_SoldierAnimator(benchmark::State& state) {
   }
   double frames = 0, sessions = 0, record = 0, annotate = 0;
   for (auto _ : state) {
-    const pipeline::AnimatorRun run = pipeline::RunAnimator(config, 0);
+    const pipeline::AnimatorRun run = pipeline::RunAnimator(config);
     frames += run.rendered_frames;
     sessions += run.seconds.record + run.seconds.annotate;
     record += run.seconds.record;
@@ -62,7 +62,7 @@ void BM_SoldierAnimatorFast(benchmark::State& state) {
   const pipeline::RunConfig config = SoldierConfig("fast", 0);
   int animator = 0;
   for (auto _ : state) {
-    const pipeline::AnimatorRun run = pipeline::RunAnimator(config, animator++ % 20);
+    const pipeline::AnimatorRun run = pipeline::RunAnimator(config.ForAnimator(animator++ % 20));
     benchmark::DoNotOptimize(run.metrics->takes.size());
   }
 }

@@ -18,7 +18,7 @@ const std::string kSource = MMH_BENCH_SOURCE_DIR;
 
 mmh::study::StudyConfig Config(int animators, const std::string& fidelity) {
   mmh::Config config = mmh::Config::Load(kSource + "/configs/study_soldier.json");
-  config.Set("render.story=" + kSource + "/configs/stories/soldier.json");
+  config.Set("scenario.story=" + kSource + "/configs/stories/soldier.json");
   config.Set("run.practice=" + kSource + "/configs/stories/mario.json");
   config.Set("run.fidelity=" + fidelity);
   config.Set("study.animators=" + std::to_string(animators));

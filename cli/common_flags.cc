@@ -4,9 +4,11 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 
 #include "core/config.h"
+#include "core/duration_text.h"
 
 namespace mmh::cli {
 
@@ -50,17 +52,36 @@ ProgressBar::ProgressBar(bool enabled, std::string label, std::string unit)
     : enabled_(enabled), label_(std::move(label)), unit_(std::move(unit)) {}
 
 void ProgressBar::Update(std::int64_t done, std::int64_t total) {
-  if (!enabled_ || total <= 0) return;
-  const int width = 30;
-  const int filled = static_cast<int>(width * done / total);
+  if (!enabled_) return;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  std::fprintf(stderr, "\r%s [%s%s] %lld / %lld %s, %.0f %s/s ", label_.c_str(),
+  const double rate = seconds > 0 ? done / seconds : 0.0;
+  if (total <= 0) {
+    std::fprintf(stderr, "\r%s: %lld %s, %.0f %s/s ", label_.c_str(),
+                 static_cast<long long>(done), unit_.c_str(), rate, unit_.c_str());
+    open_line_ = true;
+    std::fflush(stderr);
+    return;
+  }
+  const int width = 30;
+  const int filled = static_cast<int>(width * std::min(done, total) / total);
+  const std::string left =
+      done > 0 && done < total ? ", " + FormatDuration(seconds / done * (total - done)) + " left"
+                               : std::string();
+  std::fprintf(stderr, "\r%s [%s%s] %lld / %lld %s, %.0f %s/s%s ", label_.c_str(),
                std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(),
-               static_cast<long long>(done), static_cast<long long>(total), unit_.c_str(),
-               seconds > 0 ? done / seconds : 0.0, unit_.c_str());
-  if (done == total) std::fprintf(stderr, "\n");
+               static_cast<long long>(done), static_cast<long long>(total), unit_.c_str(), rate,
+               unit_.c_str(), left.c_str());
+  open_line_ = done < total;
+  if (done >= total) std::fprintf(stderr, "\n");
   std::fflush(stderr);
+}
+
+void ProgressBar::Finish() {
+  if (!open_line_) return;
+  std::fprintf(stderr, "\n");
+  std::fflush(stderr);
+  open_line_ = false;
 }
 
 }  // namespace mmh::cli

@@ -50,17 +50,23 @@ std::shared_ptr<void> LimitThreads(int threads);
 // Whether progress should be drawn: stderr is a terminal and --quiet is not given.
 bool ShowProgress(const CommonFlags& common);
 
-// A progress bar on stderr (done / total, rate), or nothing when disabled.
+// The one progress display of the commands: a bar on stderr (done / total, rate, time left), or
+// a count and rate when the total is not known (total <= 0: a live sensor), or nothing when
+// disabled. The line ends when done reaches total, or with Finish().
 class ProgressBar {
  public:
   ProgressBar(bool enabled, std::string label, std::string unit = "frames");
   void Update(std::int64_t done, std::int64_t total);
+  // Ends the line (when something was drawn and the total was not reached).
+  void Finish();
+  ~ProgressBar() { Finish(); }
 
  private:
   bool enabled_;
   std::string label_;
   std::string unit_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  bool open_line_ = false;  // something drawn since the last newline
 };
 
 }  // namespace mmh::cli

@@ -63,8 +63,7 @@ void RunRegress(const RegressArgs& args, const std::vector<std::string>& argv) {
                 << "): a default changed; differences may come from that\n";
     }
     const pipeline::AnimatorRun run =
-        RunScenario(p.config, p.config.render.render.animator, out / p.scenario->name, bar, argv,
-                    args.common.threads);
+        RunScenario(p.config, out / p.scenario->name, bar, argv, args.common.threads);
     const nlohmann::json metrics = pipeline::ToJson(*run.metrics);
     const auto c = pipeline::CompareWithBaseline(*p.scenario, metrics);
     comparisons.insert(comparisons.end(), c.begin(), c.end());

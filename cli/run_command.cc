@@ -30,10 +30,11 @@ struct RunArgs {
 
 }  // namespace
 
-pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animator,
+pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config,
                                   const std::filesystem::path& out, bool progress_bar,
                                   const std::vector<std::string>& argv, int threads, bool resume) {
-  ProgressBar bar(progress_bar, "run: animator " + std::to_string(animator));
+  ProgressBar bar(progress_bar,
+                  "run: animator " + std::to_string(config.people.scenario.animator));
   const nlohmann::json resolved = config.ToJson();
   pipeline::RunFolderOptions options;
   options.resume = resume;
@@ -47,7 +48,7 @@ pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animato
                        report::RunMontageScene(run, truth, config.montage.reference_take));
     }
   };
-  return pipeline::RunToFolder(config, animator, out, options);
+  return pipeline::RunToFolder(config, out, options);
 }
 
 namespace {
@@ -55,17 +56,17 @@ namespace {
 void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
   Config config = LoadConfig(args.common);
   if (args.seed >= 0) config.Set("population.seed=" + std::to_string(args.seed));
-  if (args.animator >= 0) config.Set("render.animator=" + std::to_string(args.animator));
+  if (args.animator >= 0) config.Set("scenario.animator=" + std::to_string(args.animator));
   const pipeline::RunConfig run_config = pipeline::RunConfig::FromConfig(config);
   const auto threads = LimitThreads(args.common.threads);
   const std::filesystem::path out = args.common.out_dir;
   const bool bar = ShowProgress(args.common);
-  const pipeline::AnimatorRun run = RunScenario(run_config, run_config.render.render.animator, out,
-                                                bar, argv, args.common.threads, args.resume);
+  const pipeline::AnimatorRun run =
+      RunScenario(run_config, out, bar, argv, args.common.threads, args.resume);
   if (args.common.quiet) return;
   const pipeline::RunMetrics& m = *run.metrics;
   std::printf("run: animator %d, %zu takes of %s (%s fidelity)\n", run.participant.index,
-              run.takes.size(), run_config.render.render.story.c_str(),
+              run.takes.size(), run_config.people.scenario.story.c_str(),
               EnumName(run_config.run.fidelity));
   for (const pipeline::TakeMetrics& t : m.takes) {
     std::printf(
@@ -102,10 +103,11 @@ void AddRunCommand(CLI::App& app, const std::vector<std::string>& argv) {
   CLI::App* cmd = app.add_subcommand(
       "run", "One animator end to end: performance -> sensor -> tracker -> montage -> metrics");
   AddCommonFlags(cmd, &args->common,
-                 {.config_help = "JSON config (e.g. configs/soldier.json): render sections, "
-                                 "tracker, slider, montage, metrics, error_model, run",
+                 {.config_help = "JSON config (e.g. configs/soldier.json): scenario, people, "
+                                 "render sections, tracker, slider, montage, metrics, "
+                                 "error_model, run",
                   .config_required = true});
-  cmd->add_option("--animator", args->animator, "Participant index (sets render.animator)")
+  cmd->add_option("--animator", args->animator, "Participant index (sets scenario.animator)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", args->seed, "Population seed (sets population.seed)")
       ->check(CLI::NonNegativeNumber);

@@ -17,7 +17,7 @@ namespace mmh::cli {
 // and run.json). The takes that finished are written even when a later stage fails. `resume`
 // reuses the takes an earlier run in `out` finished (InputError when its config differs in more
 // than the montage and metrics sections, or its files do not belong to this run).
-pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config, int animator,
+pipeline::AnimatorRun RunScenario(const pipeline::RunConfig& config,
                                   const std::filesystem::path& out, bool progress_bar,
                                   const std::vector<std::string>& argv, int threads,
                                   bool resume = false);

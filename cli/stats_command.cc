@@ -28,9 +28,7 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 void RunStats(const StatsArgs& args, const std::vector<std::string>& argv) {
   const auto start = std::chrono::steady_clock::now();
-  Config config;
-  if (!args.common.config_file.empty()) config = Config::Load(args.common.config_file);
-  for (const auto& set : args.common.sets) config.Set(set);
+  const Config config = LoadConfig(args.common);
   config.RequireOnlySections({"stats"});
   const auto options = config.Get<study::StudyAnalysisOptions>("stats");
   StartGitCommitLookup();  // for run.json, while the data are read and analysed

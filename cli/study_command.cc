@@ -40,14 +40,14 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
   // Everything is computed before anything is written: bad input or a failed run leaves no output.
   const int replicates = study_config.study.replicates;
   const bool bar = ShowProgress(args.common);
+  // One bar over every animator of every replicate.
+  ProgressBar progress_bar(bar, "study", "animators");
   const study::StudyResults results = study::RunStudyReplicates(
       study_config, paper, [&](int replicate, int done, int total) {
-        if (bar) {
-          std::cerr << "\rstudy: replicate " << replicate + 1 << " / " << replicates
-                    << ", animator " << done << " / " << total << std::flush;
-        }
+        progress_bar.Update(std::int64_t{replicate} * total + done,
+                            std::int64_t{replicates} * total);
       });
-  if (bar) std::cerr << '\n';
+  progress_bar.Finish();
 
   const nlohmann::json resolved = study_config.ToJson();
   study::WriteStudyFolder(

@@ -235,34 +235,14 @@ struct Generated {
   std::vector<Flaw> flaws;
 };
 
-Generated Generate(const StoryObject& object, const Plan& plan, int frames,
-                   const PerformanceOptions& options) {
-  Generated out;
-  const double dt = 1.0 / options.frame_rate;
-  const std::vector<Segment>& segments = plan.segments;
-  std::vector<double> seg_start(segments.size() + 1, 0.0);
-  for (std::size_t k = 0; k < segments.size(); ++k) {
-    seg_start[k + 1] = seg_start[k] + segments[k].TotalSeconds();
-  }
-
-  // State carried across frames.
-  Eigen::Vector2d position = object.path[object.start_waypoint];
-  Eigen::Vector2d previous = position;
+// The figure's state, carried from frame to frame while a take is generated.
+struct Figure {
+  Eigen::Vector2d position;
+  Eigen::Vector2d previous;
   double heading = 0, heading_target = 0;
-  {
-    // Start facing along the first travelling beat.
-    for (const Segment& seg : segments) {
-      if (seg.polyline.size() >= 2) {
-        Eigen::Vector2d tangent;
-        PolylinePoint(seg.polyline, 0.0, &tangent);
-        heading = heading_target = std::atan2(tangent.y(), tangent.x());
-        break;
-      }
-    }
-  }
   double pitch = 0, roll = 0, z = 0, yaw_extra = 0;
   double step_phase = 0;
-  double turn_from = heading;
+  double turn_from = 0;
   double segment_pitch = 0;
   // The current segment's path from where the figure actually stood when it began (after a hit
   // it stands where the target was), set once per segment.
@@ -270,177 +250,195 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
   double length = 0;
   Eigen::Vector2d start_tangent = Eigen::Vector2d::Zero();
   bool closed = false;
-  int current = -1;
-  const double heading_gain = 1 - std::exp(-dt / options.heading_time_constant);
-  const double smooth_gain = 1 - std::exp(-dt / 0.04);
+};
 
-  for (int i = 0; i < frames; ++i) {
-    const double t = i * dt;
-    int k = current < 0 ? 0 : current;
-    while (k + 1 < static_cast<int>(segments.size()) && t >= seg_start[k + 1]) ++k;
-    const Segment& seg = segments[k];
-    const Beat& beat = object.beats[seg.script_beat];
-    if (k != current) {
-      // A new segment starts from where the last one left the figure.
-      if (!out.segments.empty()) out.segments.back().last_frame = i - 1;
-      out.segments.push_back({seg.script_beat, seg.kind, i, i});
-      turn_from = heading;
-      segment_pitch = pitch;
-      current = k;
-      polyline.clear();
-      if (seg.polyline.size() >= 2 || seg.hit_target) {
-        closed = (seg.polyline.front() - seg.polyline.back()).norm() < 1e-6;
-        polyline = seg.polyline;
-        polyline.front() = position;
-        if (seg.hit_target) polyline = {position, seg.hit_target->head<2>()};
-        length = PolylineLength(polyline);
-        PolylinePoint(polyline, 0.0, &start_tangent);
-      }
+// At the object's start waypoint, facing along the first travelling beat.
+Figure StartFigure(const StoryObject& object, const std::vector<Segment>& segments) {
+  Figure f;
+  f.position = object.path[object.start_waypoint];
+  f.previous = f.position;
+  for (const Segment& seg : segments) {
+    if (seg.polyline.size() >= 2) {
+      Eigen::Vector2d tangent;
+      PolylinePoint(seg.polyline, 0.0, &tangent);
+      f.heading = f.heading_target = std::atan2(tangent.y(), tangent.x());
+      break;
     }
-    const double tau = t - seg_start[k];
-    const double p = seg.Progress(tau);
-    const bool hesitating = seg.Hesitating(tau);
-    const double intensity = seg.amplitude * beat.IntensityAt(p);
-    const BeatStyleTarget target = ScriptTarget(seg.kind);
-
-    // Where the figure stands.
-    if (!polyline.empty()) {
-      if (seg.kind == BeatKind::kHit || seg.hit_target) {
-        position = PolylinePoint(polyline, length * Ease(std::min(p / kHitApproachEnd, 1.0)));
-      } else if (seg.wrong_direction && !closed) {
-        // Sets off the wrong way, notices, comes back, then does the beat in the time left.
-        if (p < 0.5) {
-          position = polyline.front() - start_tangent * 0.35 * length * std::sin(kPi * p / 0.5);
-        } else {
-          position = PolylinePoint(polyline, length * Ease((p - 0.5) / 0.5));
-        }
-      } else {
-        position = PolylinePoint(polyline, length * Ease(p));
-      }
-      if (seg.off_area && p > seg.off_from && p < seg.off_from + 0.3) {
-        const Eigen::Vector2d outward = position.norm() > 1e-6
-                                            ? Eigen::Vector2d(position.normalized())
-                                            : Eigen::Vector2d::UnitY();
-        position += outward * seg.off_size * std::sin(kPi * (p - seg.off_from) / 0.3);
-      }
-    }
-
-    // Where it faces.
-    const Eigen::Vector2d step = position - previous;
-    if (Travels(seg.kind) && step.norm() > 0.0003) {
-      heading_target = std::atan2(step.y(), step.x());
-    }
-    if (seg.kind == BeatKind::kTurn) {
-      // Towards the next travelling beat's direction.
-      double wanted = turn_from;
-      for (std::size_t n = k + 1; n < segments.size(); ++n) {
-        if (segments[n].polyline.size() >= 2) {
-          Eigen::Vector2d tangent;
-          PolylinePoint(segments[n].polyline, 0.0, &tangent);
-          wanted = std::atan2(tangent.y(), tangent.x());
-          break;
-        }
-      }
-      heading_target = turn_from + WrapAngle(wanted - turn_from) * Smoothstep(p);
-    }
-    heading += WrapAngle(heading_target - heading) * heading_gain;
-    previous = position;
-
-    // Steps, hops, sway, head turns and tilt.
-    double z_target = 0, roll_target = 0, yaw_target = 0;
-    const bool moving = !hesitating;
-    if (moving && (IsGait(seg.kind) || seg.kind == BeatKind::kJump)) {
-      step_phase += target.step_rate * plan.style.tempo * dt;
-    }
-    switch (seg.kind) {
-      case BeatKind::kWalk:
-      case BeatKind::kMarch:
-      case BeatKind::kStroll:
-      case BeatKind::kLimp: {
-        double rise =
-            target.bounce * intensity * plan.style.bounce * std::abs(std::sin(kPi * step_phase));
-        if (seg.kind == BeatKind::kLimp && static_cast<long>(std::floor(step_phase)) % 2 == 1) {
-          rise *= 0.4;  // the bad leg's short step
-        }
-        if (moving) z_target = rise;
-        const double sway = target.sway * intensity * plan.style.sway;
-        if (seg.kind == BeatKind::kStroll) roll_target = sway * std::sin(kPi * step_phase);
-        if (seg.kind == BeatKind::kLimp) {
-          roll_target = sway * (0.6 + 0.4 * std::sin(kPi * step_phase));
-        }
-        break;
-      }
-      case BeatKind::kJump: {
-        const double f = step_phase - std::floor(step_phase);
-        if (moving) z_target = target.bounce * intensity * plan.style.bounce * 4 * f * (1 - f);
-        break;
-      }
-      case BeatKind::kHit: {
-        const double top = seg.hit_target ? seg.hit_target->z() : object.height;
-        if (p < kHitApproachEnd) {
-          z_target = ScriptTarget(BeatKind::kWalk).bounce * plan.style.bounce *
-                     std::abs(std::sin(kPi * step_phase));
-        } else {
-          z_target = top * std::sin(kPi * (p - kHitApproachEnd) / (1 - kHitApproachEnd));
-        }
-        break;
-      }
-      case BeatKind::kLookAround:
-        yaw_target = ScriptTarget(BeatKind::kLookAround).yaw_swing * intensity * plan.style.yaw *
-                     std::sin(2 * kPi * 0.35 * tau) * std::sqrt(std::sin(kPi * p));
-        break;
-      default:
-        break;
-    }
-    switch (seg.kind) {
-      case BeatKind::kSlip:
-        pitch = segment_pitch + (-target.tilt * seg.amplitude - segment_pitch) * Smoothstep(p);
-        break;
-      case BeatKind::kFall:
-        pitch = segment_pitch + (-seg.fall_tilt - segment_pitch) * p * p;
-        break;
-      case BeatKind::kLie:
-        pitch = segment_pitch;
-        break;
-      case BeatKind::kGetUp:
-        pitch = segment_pitch * (1 - Smoothstep(p)) +
-                0.06 * (1 - plan.skill) * std::sin(2 * kPi * 1.5 * tau) * std::sin(kPi * p);
-        break;
-      default:
-        pitch *= std::exp(-dt / 0.25);  // stands up straight again
-        break;
-    }
-    z += (z_target - z) * smooth_gain;
-    roll += (roll_target - roll) * smooth_gain;
-    yaw_extra += (yaw_target - yaw_extra) * smooth_gain;
-
-    // The hand: slow wander and tremor.
-    Eigen::Vector3d xyz(position.x(), position.y(), z + kHalfDepth * std::abs(std::sin(pitch)));
-    xyz.x() += plan.wander_amplitude * plan.wander[0](t);
-    xyz.y() += plan.wander_amplitude * plan.wander[1](t);
-    for (int a = 0; a < 3; ++a) xyz[a] += plan.tremor_amplitude * plan.tremor[a](t);
-    // The table stops the figure: the tremor can lift it, never push it in.
-    xyz.z() = std::max(xyz.z(), kHalfDepth * std::abs(std::sin(pitch)));
-    const double angle = plan.tremor_amplitude * options.tremor_angle;
-    const Eigen::Quaterniond tremor =
-        AxisAngle(angle * plan.tremor[3](t), Eigen::Vector3d::UnitX()) *
-        AxisAngle(angle * plan.tremor[4](t), Eigen::Vector3d::UnitY()) *
-        AxisAngle(angle * plan.tremor[5](t), Eigen::Vector3d::UnitZ());
-    // yaw = heading + π/2: the figure's front (−y) faces the heading (docs/notation.md).
-    const Eigen::Quaterniond rotation =
-        AxisAngle(heading + kPi / 2 + yaw_extra, Eigen::Vector3d::UnitZ()) *
-        AxisAngle(pitch, Eigen::Vector3d::UnitX()) * AxisAngle(roll, Eigen::Vector3d::UnitY()) *
-        tremor;
-    out.table_T_proxy.timestamps.push_back(t);
-    out.table_T_proxy.poses.push_back(Rigid3(rotation.normalized(), xyz));
-    out.script_beat.push_back(seg.script_beat);
-    out.kind.push_back(seg.kind);
-    out.progress.push_back(p);
   }
-  if (!out.segments.empty()) out.segments.back().last_frame = frames - 1;
+  f.turn_from = f.heading;
+  return f;
+}
 
-  // Flaws with the frames they affect.
-  for (const PerformedSegment& performed : out.segments) {
+// A new segment starts from where the last one left the figure.
+void BeginSegment(const Segment& seg, Figure& f) {
+  f.turn_from = f.heading;
+  f.segment_pitch = f.pitch;
+  f.polyline.clear();
+  if (seg.polyline.size() >= 2 || seg.hit_target) {
+    f.closed = (seg.polyline.front() - seg.polyline.back()).norm() < 1e-6;
+    f.polyline = seg.polyline;
+    f.polyline.front() = f.position;
+    if (seg.hit_target) f.polyline = {f.position, seg.hit_target->head<2>()};
+    f.length = PolylineLength(f.polyline);
+    PolylinePoint(f.polyline, 0.0, &f.start_tangent);
+  }
+}
+
+// Where the figure stands at progress p of the segment.
+void Place(const Segment& seg, double p, Figure& f) {
+  if (f.polyline.empty()) return;
+  if (seg.kind == BeatKind::kHit || seg.hit_target) {
+    f.position = PolylinePoint(f.polyline, f.length * Ease(std::min(p / kHitApproachEnd, 1.0)));
+  } else if (seg.wrong_direction && !f.closed) {
+    // Sets off the wrong way, notices, comes back, then does the beat in the time left.
+    if (p < 0.5) {
+      f.position = f.polyline.front() - f.start_tangent * 0.35 * f.length * std::sin(kPi * p / 0.5);
+    } else {
+      f.position = PolylinePoint(f.polyline, f.length * Ease((p - 0.5) / 0.5));
+    }
+  } else {
+    f.position = PolylinePoint(f.polyline, f.length * Ease(p));
+  }
+  if (seg.off_area && p > seg.off_from && p < seg.off_from + 0.3) {
+    const Eigen::Vector2d outward = f.position.norm() > 1e-6
+                                        ? Eigen::Vector2d(f.position.normalized())
+                                        : Eigen::Vector2d::UnitY();
+    f.position += outward * seg.off_size * std::sin(kPi * (p - seg.off_from) / 0.3);
+  }
+}
+
+// Where it faces: along its steps, or (a turn) towards the next travelling beat's direction;
+// the heading follows its target with a first-order lag (heading_gain per frame).
+void Face(const std::vector<Segment>& segments, int k, double p, double heading_gain,
+          Figure& f) {
+  const Segment& seg = segments[k];
+  const Eigen::Vector2d step = f.position - f.previous;
+  if (Travels(seg.kind) && step.norm() > 0.0003) {
+    f.heading_target = std::atan2(step.y(), step.x());
+  }
+  if (seg.kind == BeatKind::kTurn) {
+    double wanted = f.turn_from;
+    for (std::size_t n = k + 1; n < segments.size(); ++n) {
+      if (segments[n].polyline.size() >= 2) {
+        Eigen::Vector2d tangent;
+        PolylinePoint(segments[n].polyline, 0.0, &tangent);
+        wanted = std::atan2(tangent.y(), tangent.x());
+        break;
+      }
+    }
+    f.heading_target = f.turn_from + WrapAngle(wanted - f.turn_from) * Smoothstep(p);
+  }
+  f.heading += WrapAngle(f.heading_target - f.heading) * heading_gain;
+  f.previous = f.position;
+}
+
+// Steps, hops, sway, head turns and tilt at time tau (progress p) into the segment.
+void Animate(const StoryObject& object, const Plan& plan, const Segment& seg, double tau,
+             double p, bool hesitating, double dt, Figure& f) {
+  const Beat& beat = object.beats[seg.script_beat];
+  const double intensity = seg.amplitude * beat.IntensityAt(p);
+  const BeatStyleTarget target = ScriptTarget(seg.kind);
+  const double smooth_gain = 1 - std::exp(-dt / 0.04);
+  double z_target = 0, roll_target = 0, yaw_target = 0;
+  const bool moving = !hesitating;
+  if (moving && (IsGait(seg.kind) || seg.kind == BeatKind::kJump)) {
+    f.step_phase += target.step_rate * plan.style.tempo * dt;
+  }
+  switch (seg.kind) {
+    case BeatKind::kWalk:
+    case BeatKind::kMarch:
+    case BeatKind::kStroll:
+    case BeatKind::kLimp: {
+      double rise =
+          target.bounce * intensity * plan.style.bounce * std::abs(std::sin(kPi * f.step_phase));
+      if (seg.kind == BeatKind::kLimp && static_cast<long>(std::floor(f.step_phase)) % 2 == 1) {
+        rise *= 0.4;  // the bad leg's short step
+      }
+      if (moving) z_target = rise;
+      const double sway = target.sway * intensity * plan.style.sway;
+      if (seg.kind == BeatKind::kStroll) roll_target = sway * std::sin(kPi * f.step_phase);
+      if (seg.kind == BeatKind::kLimp) {
+        roll_target = sway * (0.6 + 0.4 * std::sin(kPi * f.step_phase));
+      }
+      break;
+    }
+    case BeatKind::kJump: {
+      const double phase = f.step_phase - std::floor(f.step_phase);
+      if (moving) {
+        z_target = target.bounce * intensity * plan.style.bounce * 4 * phase * (1 - phase);
+      }
+      break;
+    }
+    case BeatKind::kHit: {
+      const double top = seg.hit_target ? seg.hit_target->z() : object.height;
+      if (p < kHitApproachEnd) {
+        z_target = ScriptTarget(BeatKind::kWalk).bounce * plan.style.bounce *
+                   std::abs(std::sin(kPi * f.step_phase));
+      } else {
+        z_target = top * std::sin(kPi * (p - kHitApproachEnd) / (1 - kHitApproachEnd));
+      }
+      break;
+    }
+    case BeatKind::kLookAround:
+      yaw_target = ScriptTarget(BeatKind::kLookAround).yaw_swing * intensity * plan.style.yaw *
+                   std::sin(2 * kPi * 0.35 * tau) * std::sqrt(std::sin(kPi * p));
+      break;
+    default:
+      break;
+  }
+  switch (seg.kind) {
+    case BeatKind::kSlip:
+      f.pitch = f.segment_pitch + (-target.tilt * seg.amplitude - f.segment_pitch) * Smoothstep(p);
+      break;
+    case BeatKind::kFall:
+      f.pitch = f.segment_pitch + (-seg.fall_tilt - f.segment_pitch) * p * p;
+      break;
+    case BeatKind::kLie:
+      f.pitch = f.segment_pitch;
+      break;
+    case BeatKind::kGetUp:
+      f.pitch = f.segment_pitch * (1 - Smoothstep(p)) +
+                0.06 * (1 - plan.skill) * std::sin(2 * kPi * 1.5 * tau) * std::sin(kPi * p);
+      break;
+    default:
+      f.pitch *= std::exp(-dt / 0.25);  // stands up straight again
+      break;
+  }
+  f.z += (z_target - f.z) * smooth_gain;
+  f.roll += (roll_target - f.roll) * smooth_gain;
+  f.yaw_extra += (yaw_target - f.yaw_extra) * smooth_gain;
+}
+
+// table_T_proxy at time t: the figure's pose as the hand holds it, with the hand's slow wander
+// and tremor.
+Rigid3 HeldPose(const Figure& f, const Plan& plan, const PerformanceOptions& options, double t) {
+  Eigen::Vector3d xyz(f.position.x(), f.position.y(),
+                      f.z + kHalfDepth * std::abs(std::sin(f.pitch)));
+  xyz.x() += plan.wander_amplitude * plan.wander[0](t);
+  xyz.y() += plan.wander_amplitude * plan.wander[1](t);
+  for (int a = 0; a < 3; ++a) xyz[a] += plan.tremor_amplitude * plan.tremor[a](t);
+  // The table stops the figure: the tremor can lift it, never push it in.
+  xyz.z() = std::max(xyz.z(), kHalfDepth * std::abs(std::sin(f.pitch)));
+  const double angle = plan.tremor_amplitude * options.tremor_angle;
+  const Eigen::Quaterniond tremor =
+      AxisAngle(angle * plan.tremor[3](t), Eigen::Vector3d::UnitX()) *
+      AxisAngle(angle * plan.tremor[4](t), Eigen::Vector3d::UnitY()) *
+      AxisAngle(angle * plan.tremor[5](t), Eigen::Vector3d::UnitZ());
+  // yaw = heading + π/2: the figure's front (−y) faces the heading (docs/notation.md).
+  const Eigen::Quaterniond rotation =
+      AxisAngle(f.heading + kPi / 2 + f.yaw_extra, Eigen::Vector3d::UnitZ()) *
+      AxisAngle(f.pitch, Eigen::Vector3d::UnitX()) * AxisAngle(f.roll, Eigen::Vector3d::UnitY()) *
+      tremor;
+  return Rigid3(rotation.normalized(), xyz);
+}
+
+// The planned flaws with the frames they affect, within their performed segments.
+std::vector<Flaw> FlawFrames(const std::vector<Segment>& segments,
+                             const std::vector<double>& seg_start,
+                             const std::vector<PerformedSegment>& performed_segments,
+                             const PerformanceOptions& options) {
+  std::vector<Flaw> flaws;
+  for (const PerformedSegment& performed : performed_segments) {
     int k = 0;
     while (segments[k].script_beat != performed.script_beat) ++k;
     const Segment& seg = segments[k];
@@ -463,9 +461,48 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
       }
       flaw.first_frame = std::clamp(flaw.first_frame, performed.first_frame, performed.last_frame);
       flaw.last_frame = std::clamp(flaw.last_frame, flaw.first_frame, performed.last_frame);
-      out.flaws.push_back(flaw);
+      flaws.push_back(flaw);
     }
   }
+  return flaws;
+}
+
+Generated Generate(const StoryObject& object, const Plan& plan, int frames,
+                   const PerformanceOptions& options) {
+  Generated out;
+  const double dt = 1.0 / options.frame_rate;
+  const std::vector<Segment>& segments = plan.segments;
+  std::vector<double> seg_start(segments.size() + 1, 0.0);
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    seg_start[k + 1] = seg_start[k] + segments[k].TotalSeconds();
+  }
+  Figure figure = StartFigure(object, segments);
+  int current = -1;
+  const double heading_gain = 1 - std::exp(-dt / options.heading_time_constant);
+  for (int i = 0; i < frames; ++i) {
+    const double t = i * dt;
+    int k = current < 0 ? 0 : current;
+    while (k + 1 < static_cast<int>(segments.size()) && t >= seg_start[k + 1]) ++k;
+    const Segment& seg = segments[k];
+    if (k != current) {
+      if (!out.segments.empty()) out.segments.back().last_frame = i - 1;
+      out.segments.push_back({seg.script_beat, seg.kind, i, i});
+      current = k;
+      BeginSegment(seg, figure);
+    }
+    const double tau = t - seg_start[k];
+    const double p = seg.Progress(tau);
+    Place(seg, p, figure);
+    Face(segments, k, p, heading_gain, figure);
+    Animate(object, plan, seg, tau, p, seg.Hesitating(tau), dt, figure);
+    out.table_T_proxy.timestamps.push_back(t);
+    out.table_T_proxy.poses.push_back(HeldPose(figure, plan, options, t));
+    out.script_beat.push_back(seg.script_beat);
+    out.kind.push_back(seg.kind);
+    out.progress.push_back(p);
+  }
+  if (!out.segments.empty()) out.segments.back().last_frame = frames - 1;
+  out.flaws = FlawFrames(segments, seg_start, out.segments, options);
   return out;
 }
 

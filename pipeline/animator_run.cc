@@ -8,6 +8,7 @@
 #include <chrono>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "core/error.h"
 #include "core/options.h"
@@ -146,6 +147,206 @@ std::vector<double> MontageQuality(const montage::Montage& m, const std::vector<
   return people::CompositeQuality(quality, take_of_frame, source_frame);
 }
 
+// The stories' scripts of the run: the scenario's, and the practice story's (run.practice).
+struct Scripts {
+  explicit Scripts(const RunConfig& config) : main(config.people, config.render.scene) {
+    if (!config.run.practice.empty()) {
+      practice.emplace(config.people, config.render.scene, config.run.practice, 0,
+                       "run.practice's object");
+    }
+  }
+  sim::StoryScript main;
+  std::optional<sim::StoryScript> practice;
+};
+
+// Every take the participant performs, the practice take first, with its ground truth cut to
+// render.frames (when set: a quick look, or a short regression test). A performed take that is
+// then no longer than the montage's shortest segment is refused now (the montage would refuse it,
+// after all the rendering and tracking).
+std::vector<TakeRun> PerformTakes(const RunConfig& config, const Scripts& scripts) {
+  std::vector<TakeRun> takes;
+  const int practice_takes = scripts.practice ? 1 : 0;
+  if (scripts.practice) {
+    TakeRun t;
+    t.take = 0;
+    t.performed = scripts.practice->Perform(0);
+    takes.push_back(std::move(t));
+  }
+  for (int k = 0; k < config.run.takes; ++k) {
+    TakeRun t;
+    t.take = practice_takes + k;
+    t.performed = scripts.main.Perform(t.take);
+    t.annotation = scripts.main.Annotate(t.performed);
+    takes.push_back(std::move(t));
+  }
+  const int render_frames = config.render.render.frames;
+  for (TakeRun& t : takes) {
+    const int frames = render_frames == 0 ? t.performed.frames()
+                                          : std::min(render_frames, t.performed.frames());
+    t.truth = t.performed.table_T_proxy;
+    t.truth.timestamps.resize(frames);
+    t.truth.poses.resize(frames);
+    if (!t.annotation.slider.empty()) {
+      t.truth_annotation = t.annotation.SliderAnnotation(config.people.performance.frame_rate);
+      t.truth_annotation.timestamps.resize(frames);
+      t.truth_annotation.values.resize(frames);
+    }
+  }
+  const int d = config.montage.labelling.min_segment_length;
+  for (std::size_t slot = practice_takes; slot < takes.size(); ++slot) {
+    const int frames = static_cast<int>(takes[slot].truth.size());
+    if (d > 0 && frames <= d) {
+      ThrowBadValue("take " + std::to_string(takes[slot].take) + " of animator " +
+                        std::to_string(config.people.scenario.animator) + " (" +
+                        config.people.scenario.story + ")",
+                    std::to_string(frames) + " frames",
+                    "more than montage.labelling.min_segment_length = " + std::to_string(d) +
+                        " frames (the shortest segment a montage may take)");
+    }
+  }
+  return takes;
+}
+
+// The proxies' models: rendered by the sensor, given to the tracker, and the metrics' points.
+// meshes[0] is the takes' (render.proxy, or the story object's), meshes[1] the practice take's.
+struct ProxyModels {
+  std::vector<TriangleMesh> meshes;
+  std::vector<std::string> names;  // for messages: the file, or "the Soldier"
+};
+
+ProxyModels LoadProxyModels(const RunConfig& config, const Scripts& scripts) {
+  ProxyModels models;
+  const sim::RenderOptions& render = config.render.render;
+  const std::string main_proxy = render.proxy.empty() ? scripts.main.ProxyFile() : render.proxy;
+  models.meshes.push_back(sim::LoadProxyModel(main_proxy, render.proxy_scale));
+  models.names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
+  if (scripts.practice) {
+    const std::string practice_proxy = scripts.practice->ProxyFile();
+    models.meshes.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
+    models.names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
+  }
+  return models;
+}
+
+// Full fidelity: renders and tracks every session of the takes not `loaded` (the recording of
+// each, and the annotation of each but the practice take) and fills in their results. Returns the
+// frames rendered; sets seconds.record and seconds.annotate.
+int RunSessions(const RunConfig& config, const Scripts& scripts, const ProxyModels& models,
+                const std::vector<bool>& loaded, const Progress& progress,
+                std::vector<TakeRun>& takes, StageSeconds& seconds) {
+  // Every session is its own job (scene, sensor, tracker); jobs run in parallel and each renders
+  // its frames in order, so the results do not depend on the thread count.
+  const int practice_takes = scripts.practice ? 1 : 0;
+  std::vector<SessionJob> jobs;
+  std::int64_t total_frames = 0;
+  for (size_t slot = 0; slot < takes.size(); ++slot) {
+    if (loaded[slot]) continue;
+    const TakeRun& t = takes[slot];
+    const bool is_practice = practice_takes && slot == 0;
+    const int model = is_practice ? 1 : 0;
+    const int frames = static_cast<int>(t.truth.poses.size());
+    const sim::StoryScript& take_script = is_practice ? *scripts.practice : scripts.main;
+    SessionJob recording;
+    recording.take_slot = static_cast<int>(slot);
+    recording.model = &models.meshes[model];
+    recording.model_name = models.names[model];
+    recording.frames = take_script.RecordingFrames(t.performed, frames);
+    jobs.push_back(std::move(recording));
+    total_frames += frames;
+    if (!is_practice) {
+      SessionJob annotation;
+      annotation.take_slot = static_cast<int>(slot);
+      annotation.annotation = true;
+      annotation.model = &models.meshes[model];
+      annotation.model_name = models.names[model];
+      annotation.frames = take_script.AnnotationFrames(t.annotation, frames);
+      jobs.push_back(std::move(annotation));
+      total_frames += frames;
+    }
+  }
+  // Longest jobs first (a recording frame costs about 1.6 annotation frames: the tracker's ICP
+  // against the slider reader), each worker taking the next job when it is free: the greedy
+  // longest-processing-time schedule keeps both cores busy to the end.
+  auto cost = [&](const SessionJob& job) {
+    return static_cast<double>(job.frames.table_T_proxy.size()) * (job.annotation ? 1.0 : 1.6);
+  };
+  std::vector<int> order(jobs.size());
+  for (size_t i = 0; i < jobs.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return cost(jobs[a]) > cost(jobs[b]); });
+  std::atomic<std::int64_t> done{0};
+  std::mutex progress_mutex;
+  auto frame_done = [&] {
+    const std::int64_t d = ++done;
+    if (progress && (d % 32 == 0 || d == total_frames)) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      progress(d, total_frames);
+    }
+  };
+  const auto t0 = Clock::now();
+  std::atomic<int> next{0};
+  const int workers = std::min(static_cast<int>(jobs.size()),
+                               std::max(1, tbb::this_task_arena::max_concurrency()));
+  // Isolated: a thread waiting inside a job's own parallel loops (the sensor's) helps only that
+  // job, instead of starting another job and leaving the first one stalled mid-frame.
+  tbb::parallel_for(0, workers, 1, [&](int) {
+    for (int k = next++; k < static_cast<int>(order.size()); k = next++) {
+      tbb::this_task_arena::isolate([&] {
+        RunSession(config.render, config.tracker, config.slider, jobs[order[k]], frame_done);
+      });
+    }
+  });
+  const double sessions_seconds = SecondsSince(t0);
+  double record_cpu = 0.0, annotate_cpu = 0.0;
+  for (const SessionJob& job : jobs) {
+    TakeRun& t = takes[job.take_slot];
+    if (job.annotation) {
+      CollectAnnotation(job, t);
+      annotate_cpu += job.seconds;
+    } else {
+      CollectRecording(job, t);
+      record_cpu += job.seconds;
+    }
+  }
+  // The sessions ran interleaved: split their wall clock in proportion to their thread time.
+  const double cpu = record_cpu + annotate_cpu;
+  seconds.record = cpu > 0 ? sessions_seconds * record_cpu / cpu : 0.0;
+  seconds.annotate = cpu > 0 ? sessions_seconds * annotate_cpu / cpu : 0.0;
+  return static_cast<int>(total_frames);
+}
+
+// A take with too few tracked frames fails the run (RunError).
+void CheckTracked(const TakeRun& t, const std::string& what, const RunOptions& options) {
+  if (t.EstimatedShare() < options.min_tracked_share) {
+    throw RunError(what + ": tracking failed: " + FormatNumber(100.0 * t.EstimatedShare()) +
+                   " % of its " + std::to_string(t.status.size()) +
+                   " frames have a pose, run.min_tracked_share asks for at least " +
+                   FormatNumber(100.0 * options.min_tracked_share) +
+                   " %; see its status.csv for the reasons");
+  }
+}
+
+// The system's montage (tracked takes, read annotations) and, with run.metrics, the ground
+// truth's, each with the latent quality of its frames.
+void ComposeMontages(const RunConfig& config, AnimatorRun& result) {
+  std::vector<Trajectory> tracked, truth;
+  std::vector<Annotation> read, truth_annotations;
+  std::vector<std::string> names;
+  for (const TakeRun& t : result.takes) {
+    tracked.push_back(t.tracked);
+    truth.push_back(t.truth);
+    read.push_back(t.read_annotation);
+    truth_annotations.push_back(t.truth_annotation);
+    names.push_back("take " + std::to_string(t.take));
+  }
+  result.montage = montage::Compose(tracked, read, config.montage, names);
+  result.montage_quality = MontageQuality(result.montage, result.takes);
+  if (config.run.metrics) {
+    result.truth_montage = montage::Compose(truth, truth_annotations, config.montage, names);
+    result.truth_montage_quality = MontageQuality(result.truth_montage, result.takes);
+  }
+}
+
 }  // namespace
 
 std::span<const std::pair<Fidelity, const char*>> EnumNames(Fidelity) { return kFidelityNames; }
@@ -171,26 +372,26 @@ void RunOptions::Validate(const std::string& prefix) const {
 
 RunConfig RunConfig::FromConfig(const Config& config,
                                 const std::vector<std::string>& extra_sections) {
-  std::vector<std::string> sections = {"render",    "camera",      "scene",      "hand",
-                                       "sensor",    "motion",      "population", "performance",
-                                       "annotator", "tracker",     "slider",     "montage",
-                                       "metrics",   "error_model", "run"};
+  std::vector<std::string> sections = {"render",      "camera",     "scene",       "hand",
+                                       "sensor",      "motion",     "scenario",    "population",
+                                       "performance", "annotator",  "tracker",     "slider",
+                                       "montage",     "metrics",    "error_model", "run"};
   sections.insert(sections.end(), extra_sections.begin(), extra_sections.end());
   config.RequireOnlySections(sections);
   RunConfig c;
   c.render = sim::RenderConfig::FromConfig(config);
+  c.people = people::PeopleConfig::FromConfig(config);
   c.tracker = config.Get<track::ProxyTrackerOptions>("tracker");
   c.slider = config.Get<track::SliderReaderOptions>("slider");
   c.montage = config.Get<montage::ComposeOptions>("montage");
   c.metrics = config.Get<metrics::PoseErrorOptions>("metrics");
   c.error_model = config.Get<ErrorModelOptions>("error_model");
   c.run = config.Get<RunOptions>("run");
-  if (c.render.render.story.empty()) {
-    ThrowBadValue("render.story", "\"\"", "a story file (e.g. configs/stories/soldier.json)");
+  if (c.people.scenario.story.empty()) {
+    ThrowBadValue("scenario.story", "\"\"", "a story file (e.g. configs/stories/soldier.json)");
   }
   // The stories are read now, so that a missing or broken one stops the run before any output.
-  sim::StoryScript(c.render, c.render.render.story, c.render.render.object,
-                   c.render.render.animator);
+  [[maybe_unused]] const Scripts scripts(c);
   // Takes the montage would refuse (no longer than the shortest segment) are refused now, before
   // anything is performed, rendered or tracked.
   const int d = c.montage.labelling.min_segment_length;
@@ -199,11 +400,8 @@ RunConfig RunConfig::FromConfig(const Config& config,
                   "0 (whole takes) or more than montage.labelling.min_segment_length = " +
                       std::to_string(d) + " frames (the shortest segment a montage may take)");
   }
-  if (!c.run.practice.empty()) {
-    sim::StoryScript(c.render, c.run.practice, 0, c.render.render.animator, "run.practice's object");
-  }
-  if (std::abs(c.render.performance.frame_rate - c.render.sensor.frame_rate) > 1e-9) {
-    ThrowBadValue("performance.frame_rate", FormatNumber(c.render.performance.frame_rate),
+  if (std::abs(c.people.performance.frame_rate - c.render.sensor.frame_rate) > 1e-9) {
+    ThrowBadValue("performance.frame_rate", FormatNumber(c.people.performance.frame_rate),
                   "the sensor's frame rate (sensor.frame_rate = " +
                       FormatNumber(c.render.sensor.frame_rate) + ")");
   }
@@ -212,6 +410,7 @@ RunConfig RunConfig::FromConfig(const Config& config,
 
 nlohmann::json RunConfig::ToJson() const {
   nlohmann::json j = render.ToJson();
+  people.AddToJson(j);
   j["tracker"] = mmh::ToJson(tracker);
   j["slider"] = mmh::ToJson(slider);
   j["montage"] = mmh::ToJson(montage);
@@ -219,6 +418,12 @@ nlohmann::json RunConfig::ToJson() const {
   j["error_model"] = mmh::ToJson(error_model);
   j["run"] = mmh::ToJson(run);
   return j;
+}
+
+RunConfig RunConfig::ForAnimator(int animator) const {
+  RunConfig c = *this;
+  c.people.scenario.animator = animator;
+  return c;
 }
 
 void FillGaps(std::vector<Rigid3>& poses, const std::vector<bool>& estimated) {
@@ -240,64 +445,18 @@ void FillGaps(std::vector<Rigid3>& poses, const std::vector<bool>& estimated) {
   for (int j = previous + 1; j < n; ++j) poses[j] = poses[previous];
 }
 
-AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress,
+AnimatorRun RunAnimator(const RunConfig& config, const Progress& progress,
                         const TakeDone& take_done, const TakeLoader& load) {
   const auto start = Clock::now();
-  const sim::RenderConfig& render = config.render;
-  const RunOptions& options = config.run;
   AnimatorRun result;
-  if (animator < 0) ThrowBadValue("animator", std::to_string(animator), "an index >= 0");
 
   // Perform: the practice take, the takes, and the annotation sessions (cheap; sequential).
   auto t0 = Clock::now();
-  const sim::StoryScript script(render, render.render.story, render.render.object, animator);
-  result.participant = script.participant();
-  const std::uint64_t seed = people::ParticipantSeed(render.population, animator);
-  std::optional<sim::StoryScript> practice_script;
-  const int practice_takes = options.practice.empty() ? 0 : 1;
-  std::vector<TakeRun> takes;  // the practice take first
-  if (practice_takes) {
-    practice_script.emplace(render, options.practice, 0, animator, "run.practice's object");
-    TakeRun t;
-    t.take = 0;
-    t.performed = practice_script->Perform(0);
-    takes.push_back(std::move(t));
-  }
-  for (int k = 0; k < options.takes; ++k) {
-    TakeRun t;
-    t.take = practice_takes + k;
-    t.performed = script.Perform(t.take);
-    t.annotation = script.Annotate(t.performed);
-    takes.push_back(std::move(t));
-  }
-  // render.frames (when set) shortens every session: a quick look, or a short regression test.
-  for (TakeRun& t : takes) {
-    const int frames = render.render.frames == 0
-                           ? t.performed.frames()
-                           : std::min(render.render.frames, t.performed.frames());
-    t.truth = t.performed.table_T_proxy;
-    t.truth.timestamps.resize(frames);
-    t.truth.poses.resize(frames);
-    if (!t.annotation.slider.empty()) {
-      t.truth_annotation = t.annotation.SliderAnnotation(render.performance.frame_rate);
-      t.truth_annotation.timestamps.resize(frames);
-      t.truth_annotation.values.resize(frames);
-    }
-  }
-  // A performed take can be shorter than render.frames: refuse it before rendering (the montage
-  // would, after all the work).
-  const int d = config.montage.labelling.min_segment_length;
-  for (std::size_t slot = practice_takes; slot < takes.size(); ++slot) {
-    const int frames = static_cast<int>(takes[slot].truth.size());
-    if (d > 0 && frames <= d) {
-      ThrowBadValue("take " + std::to_string(takes[slot].take) + " of animator " +
-                        std::to_string(animator) + " (" + render.render.story + ")",
-                    std::to_string(frames) + " frames",
-                    "more than montage.labelling.min_segment_length = " + std::to_string(d) +
-                        " frames (the shortest segment a montage may take)");
-    }
-  }
+  const Scripts scripts(config);
+  result.participant = scripts.main.participant();
+  std::vector<TakeRun> takes = PerformTakes(config, scripts);
   result.seconds.perform = SecondsSince(t0);
+  const int practice_takes = scripts.practice ? 1 : 0;
   // Takes whose sessions an earlier run finished.
   std::vector<bool> loaded(takes.size(), false);
   if (load) {
@@ -306,104 +465,19 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     }
   }
 
-  // The proxies' models: rendered by the sensor, given to the tracker, and the metrics' points.
-  std::vector<TriangleMesh> models;
-  std::vector<std::string> model_names;
-  const std::string main_proxy =
-      render.render.proxy.empty() ? script.ProxyFile() : render.render.proxy;
-  models.push_back(sim::LoadProxyModel(main_proxy, render.render.proxy_scale));
-  result.proxy_model = models.back();
-  model_names.push_back(main_proxy.empty() ? "the Soldier" : main_proxy);
-  if (practice_takes) {
-    const std::string practice_proxy = practice_script->ProxyFile();
-    models.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
-    model_names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
-  }
-
-  if (options.fidelity == Fidelity::kFull) {
-    // Every session is its own job (scene, sensor, tracker); jobs run in parallel and each renders
-    // its frames in order, so the results do not depend on the thread count.
-    std::vector<SessionJob> jobs;
-    std::int64_t total_frames = 0;
-    for (size_t slot = 0; slot < takes.size(); ++slot) {
-      if (loaded[slot]) continue;
-      const TakeRun& t = takes[slot];
-      const bool is_practice = practice_takes && slot == 0;
-      const int model = is_practice ? 1 : 0;
-      const int frames = static_cast<int>(t.truth.poses.size());
-      const sim::StoryScript& take_script = is_practice ? *practice_script : script;
-      SessionJob recording;
-      recording.take_slot = static_cast<int>(slot);
-      recording.model = &models[model];
-      recording.model_name = model_names[model];
-      recording.frames = take_script.RecordingFrames(t.performed, frames);
-      jobs.push_back(std::move(recording));
-      total_frames += frames;
-      if (!is_practice) {
-        SessionJob annotation;
-        annotation.take_slot = static_cast<int>(slot);
-        annotation.annotation = true;
-        annotation.model = &models[model];
-        annotation.model_name = model_names[model];
-        annotation.frames = take_script.AnnotationFrames(t.annotation, frames);
-        jobs.push_back(std::move(annotation));
-        total_frames += frames;
-      }
-    }
-    // Longest jobs first (a recording frame costs about 1.6 annotation frames: the tracker's ICP
-    // against the slider reader), each worker taking the next job when it is free: the greedy
-    // longest-processing-time schedule keeps both cores busy to the end.
-    auto cost = [&](const SessionJob& job) {
-      return static_cast<double>(job.frames.table_T_proxy.size()) * (job.annotation ? 1.0 : 1.6);
-    };
-    std::vector<int> order(jobs.size());
-    for (size_t i = 0; i < jobs.size(); ++i) order[i] = static_cast<int>(i);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](int a, int b) { return cost(jobs[a]) > cost(jobs[b]); });
-    std::atomic<std::int64_t> done{0};
-    std::mutex progress_mutex;
-    auto frame_done = [&] {
-      const std::int64_t d = ++done;
-      if (progress && (d % 32 == 0 || d == total_frames)) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        progress(d, total_frames);
-      }
-    };
-    t0 = Clock::now();
-    std::atomic<int> next{0};
-    const int workers = std::min(static_cast<int>(jobs.size()),
-                                 std::max(1, tbb::this_task_arena::max_concurrency()));
-    // Isolated: a thread waiting inside a job's own parallel loops (the sensor's) helps only that
-    // job, instead of starting another job and leaving the first one stalled mid-frame.
-    tbb::parallel_for(0, workers, 1, [&](int) {
-      for (int k = next++; k < static_cast<int>(order.size()); k = next++) {
-        tbb::this_task_arena::isolate(
-            [&] { RunSession(render, config.tracker, config.slider, jobs[order[k]], frame_done); });
-      }
-    });
-    const double sessions_seconds = SecondsSince(t0);
-    double record_cpu = 0.0, annotate_cpu = 0.0;
-    for (const SessionJob& job : jobs) {
-      TakeRun& t = takes[job.take_slot];
-      if (job.annotation) {
-        CollectAnnotation(job, t);
-        annotate_cpu += job.seconds;
-      } else {
-        CollectRecording(job, t);
-        record_cpu += job.seconds;
-      }
-    }
-    // The sessions ran interleaved: split their wall clock in proportion to their thread time.
-    const double cpu = record_cpu + annotate_cpu;
-    result.seconds.record = cpu > 0 ? sessions_seconds * record_cpu / cpu : 0.0;
-    result.seconds.annotate = cpu > 0 ? sessions_seconds * annotate_cpu / cpu : 0.0;
-    result.rendered_frames = static_cast<int>(total_frames);
+  const ProxyModels models = LoadProxyModels(config, scripts);
+  result.proxy_model = models.meshes.front();
+  if (config.run.fidelity == Fidelity::kFull) {
+    result.rendered_frames = RunSessions(config, scripts, models, loaded, progress, takes,
+                                         result.seconds);
   } else {
     t0 = Clock::now();
-    for (TakeRun& t : takes) {
-      if (loaded[&t - takes.data()]) continue;
-      SimulateSessions(config, seed, t);
-      if (progress) progress(&t - takes.data() + 1, static_cast<std::int64_t>(takes.size()));
+    const std::uint64_t seed =
+        people::ParticipantSeed(config.people.population, config.people.scenario.animator);
+    for (size_t slot = 0; slot < takes.size(); ++slot) {
+      if (loaded[slot]) continue;
+      SimulateSessions(config, seed, takes[slot]);
+      if (progress) progress(slot + 1, static_cast<std::int64_t>(takes.size()));
     }
     result.seconds.record = SecondsSince(t0);
   }
@@ -417,43 +491,20 @@ AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& p
     if (result.practice) take_done(*result.practice, true);
     for (const TakeRun& t : result.takes) take_done(t, false);
   }
-  auto check_tracked = [&](const TakeRun& t, const std::string& what) {
-    if (t.EstimatedShare() < options.min_tracked_share) {
-      throw RunError(what + ": tracking failed: " + FormatNumber(100.0 * t.EstimatedShare()) +
-                     " % of its " + std::to_string(t.status.size()) +
-                     " frames have a pose, run.min_tracked_share asks for at least " +
-                     FormatNumber(100.0 * options.min_tracked_share) +
-                     " %; see its status.csv for the reasons");
-    }
-  };
-  if (result.practice) check_tracked(*result.practice, "practice take");
-  for (const TakeRun& t : result.takes) check_tracked(t, "take " + std::to_string(t.take));
-
-  // Compose: the system's montage (tracked takes, read annotations) and the ground truth's.
-  t0 = Clock::now();
-  std::vector<Trajectory> tracked, truth;
-  std::vector<Annotation> read, truth_annotations;
-  std::vector<std::string> names;
+  if (result.practice) CheckTracked(*result.practice, "practice take", config.run);
   for (const TakeRun& t : result.takes) {
-    tracked.push_back(t.tracked);
-    truth.push_back(t.truth);
-    read.push_back(t.read_annotation);
-    truth_annotations.push_back(t.truth_annotation);
-    names.push_back("take " + std::to_string(t.take));
+    CheckTracked(t, "take " + std::to_string(t.take), config.run);
   }
-  result.montage = montage::Compose(tracked, read, config.montage, names);
-  result.montage_quality = MontageQuality(result.montage, result.takes);
-  if (options.metrics) {
-    result.truth_montage = montage::Compose(truth, truth_annotations, config.montage, names);
-    result.truth_montage_quality = MontageQuality(result.truth_montage, result.takes);
-  }
+
+  t0 = Clock::now();
+  ComposeMontages(config, result);
   result.seconds.compose = SecondsSince(t0);
 
   // metrics.json holds no timings (same config and seed, same bytes); they go to run.json.
-  if (options.metrics) {
+  if (config.run.metrics) {
     t0 = Clock::now();
-    result.metrics =
-        ComputeRunMetrics(config, result, models[0], practice_takes ? &models[1] : nullptr);
+    result.metrics = ComputeRunMetrics(config, result, models.meshes[0],
+                                       practice_takes ? &models.meshes[1] : nullptr);
     result.seconds.metrics = SecondsSince(t0);
   }
   result.seconds.total = SecondsSince(start);

@@ -29,8 +29,9 @@
 #include "people/annotator.h"
 #include "people/performance.h"
 #include "people/population.h"
-#include "sim/render_session.h"
+#include "people/scenario.h"
 #include "people/story.h"
+#include "sim/render_session.h"
 #include "track/proxy_tracker.h"
 #include "track/slider_reader.h"
 
@@ -44,7 +45,7 @@ std::span<const std::pair<Fidelity, const char*>> EnumNames(Fidelity);
 
 // Section "run".
 struct RunOptions {
-  // Takes of the story's object (render.object) recorded, annotated and composited (paper: 3).
+  // Takes of the story's object (scenario.object) recorded, annotated and composited (paper: 3).
   int takes = 3;
   // A practice story (e.g. configs/stories/mario.json) performed once before the takes (paper:
   // "the participants first practised with Mario"): recorded and tracked like a take, not
@@ -71,12 +72,13 @@ struct RunOptions {
   void Validate(const std::string& prefix) const;
 };
 
-// Every section of a run config: the render sections (sim/render_session.h; render.story,
-// render.animator and render.object choose the scenario), "tracker" and "slider" (track/),
+// Every section of a run config: the render sections (sim/render_session.h), the scenario and the
+// people's sections (people/scenario.h: what is performed and by whom), "tracker" and "slider" (track/),
 // "montage" (montage::ComposeOptions), "metrics" (metrics::PoseErrorOptions), "error_model"
 // (pipeline/error_model.h) and "run". Unknown sections and keys are errors.
 struct RunConfig {
   sim::RenderConfig render;
+  people::PeopleConfig people;
   track::ProxyTrackerOptions tracker;
   track::SliderReaderOptions slider;
   montage::ComposeOptions montage;
@@ -88,6 +90,9 @@ struct RunConfig {
   static RunConfig FromConfig(const Config& config,
                               const std::vector<std::string>& extra_sections = {});
   nlohmann::json ToJson() const;
+  // This config with participant `animator` of the population in the scenario (mmh study runs
+  // each of its animators so).
+  RunConfig ForAnimator(int animator) const;
 };
 
 // One take through the pipeline. Trajectories are table_T_proxy with timestamps i / frame_rate.
@@ -151,12 +156,12 @@ using TakeDone = std::function<void(const TakeRun& take, bool practice)>;
 // again (`mmh run --resume`).
 using TakeLoader = std::function<bool(TakeRun& take, bool practice)>;
 
-// Runs participant `animator` of config.render.population through `config.run.takes` takes of
-// config.render.story (object config.render.object). Deterministic in the config, independent of
-// the thread count. Throws InputError for bad input (a missing story, takes too short for the
+// Runs participant config.people.scenario.animator of config.people.population through
+// config.run.takes takes of the scenario's story and object. Deterministic in the config,
+// independent of the thread count. Throws InputError for bad input (a missing story, takes too short for the
 // montage), and a RunError when a take's tracking failed (fewer than run.min_tracked_share of its
 // frames estimated), naming the take.
-AnimatorRun RunAnimator(const RunConfig& config, int animator, const Progress& progress = {},
+AnimatorRun RunAnimator(const RunConfig& config, const Progress& progress = {},
                         const TakeDone& take_done = {}, const TakeLoader& load = {});
 
 // A failure of the work (exit code 1), as opposed to bad input.

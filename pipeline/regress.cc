@@ -251,7 +251,7 @@ std::string ComparisonsToCsv(const std::vector<MetricComparison>& comparisons) {
 namespace {
 
 // The config keys that name files.
-constexpr const char* kPathKeys[][2] = {{"render", "story"},
+constexpr const char* kPathKeys[][2] = {{"scenario", "story"},
                                         {"run", "practice"},
                                         {"render", "proxy"},
                                         {"render", "trajectory"},

@@ -90,7 +90,7 @@ nlohmann::json ToJson(const Scenario& scenario);
 
 // A scenario's run config, read and checked before anything runs, and the hash of its resolved
 // config with the file paths as the scenario writes them (so that it does not depend on where the
-// clone is). Relative file paths of the config (render.story, run.practice, render.proxy,
+// clone is). Relative file paths of the config (scenario.story, run.practice, render.proxy,
 // render.trajectory, render.annotation) resolve against the baseline's root, so that `mmh
 // regress` gives the same runs from any working directory.
 struct PreparedScenario {

@@ -43,7 +43,7 @@ void CheckResumable(const std::filesystem::path& out, const nlohmann::json& reso
                     "and run.min_tracked_share may change with --resume)");
 }
 
-AnimatorRun RunToFolder(const RunConfig& config, int animator, const std::filesystem::path& out,
+AnimatorRun RunToFolder(const RunConfig& config, const std::filesystem::path& out,
                         const RunFolderOptions& options) {
   if (!config.run.metrics) {
     ThrowBadValue("run.metrics", "false",
@@ -63,7 +63,7 @@ AnimatorRun RunToFolder(const RunConfig& config, int animator, const std::filesy
   AnimatorRun run;
   try {
     run = RunAnimator(
-        config, animator, options.progress,
+        config, options.progress,
         [&](const TakeRun& take, bool practice) { WriteTakeRun(out, take, practice); },
         options.resume ? TakeLoader([&](TakeRun& take, bool practice) {
           return LoadTakeRun(out, take, practice);

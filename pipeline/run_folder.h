@@ -22,13 +22,13 @@ struct RunFolderOptions {
   std::function<void(const AnimatorRun& run)> write_more;
 };
 
-// Runs participant `animator` (RunAnimator) and writes config.resolved.json first, each take
+// Runs the scenario's participant (RunAnimator) and writes config.resolved.json first, each take
 // as soon as its sessions finish (WriteTakeRun), then the montages, metrics and tables
 // (WriteAnimatorRun), timings.csv and run.json. The takes that finished stay written when a
 // later stage fails (run.json then says "failed"). InputError when config.run.metrics is false
 // (the folder holds metrics.json), and with `resume` when the folder's earlier run is not
 // resumable (CheckResumable) or its files do not belong to this run.
-AnimatorRun RunToFolder(const RunConfig& config, int animator, const std::filesystem::path& out,
+AnimatorRun RunToFolder(const RunConfig& config, const std::filesystem::path& out,
                         const RunFolderOptions& options);
 
 // --resume continues a run whose sessions were made with the same config: only the sections

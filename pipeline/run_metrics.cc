@@ -273,11 +273,10 @@ nlohmann::json ToJson(const MontageMetrics& m) {
 
 RunMetrics ComputeRunMetrics(const RunConfig& config, const AnimatorRun& run,
                              const TriangleMesh& proxy_model, const TriangleMesh* practice_model) {
-  const sim::RenderConfig& render = config.render;
-  const double fps = render.performance.frame_rate;
+  const double fps = config.people.performance.frame_rate;
   RunMetrics m;
-  m.scenario.story = render.render.story;
-  m.scenario.object = render.render.object;
+  m.scenario.story = config.people.scenario.story;
+  m.scenario.object = config.people.scenario.object;
   m.scenario.animator = run.participant.index;
   m.scenario.takes = static_cast<int>(run.takes.size());
   m.scenario.practice = config.run.practice;

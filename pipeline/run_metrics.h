@@ -122,7 +122,7 @@ struct MontageComparison {
 struct RunMetrics {
   struct Scenario {
     std::string story;
-    int object = 0;  // the story's object (render.object)
+    int object = 0;  // the story's object (scenario.object)
     int animator = 0;
     int takes = 0;
     std::string practice;

@@ -129,22 +129,12 @@ void RenderOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".frames", std::to_string(frames),
                   "a frame count in [1, 1000000], or 0 for the whole take");
   }
-  for (const auto& [value, name] :
-       {std::pair{animator, "animator"}, {take, "take"}, {object, "object"}}) {
-    if (value < 0 || value > 100000) {
-      ThrowBadValue(prefix + "." + name, std::to_string(value), "an index in [0, 100000]");
-    }
+  if (take < 0 || take > 100000) {
+    ThrowBadValue(prefix + ".take", std::to_string(take), "an index in [0, 100000]");
   }
   if (png_compression < 0 || png_compression > 9) {
     ThrowBadValue(prefix + ".png_compression", std::to_string(png_compression),
                   "a zlib level in [0, 9]");
-  }
-  if (!story.empty() && !EndsWith(story, ".json")) {
-    ThrowBadValue(prefix + ".story", "\"" + story + "\"", "a story file (.json), or empty");
-  }
-  if (!story.empty() && !trajectory.empty()) {
-    ThrowBadValue(prefix + ".trajectory", "\"" + trajectory + "\"",
-                  "empty when render.story is given (the story's take is the motion)");
   }
   RequirePositive(proxy_scale, prefix + ".proxy_scale");
   if (!proxy.empty() && !EndsWith(proxy, ".json") && !EndsWith(proxy, ".obj") &&
@@ -155,7 +145,7 @@ void RenderOptions::Validate(const std::string& prefix) const {
 }
 
 RenderConfig RenderConfig::FromConfig(const Config& config) {
-  config.RequireOnlySections({"render", "camera", "scene", "hand", "sensor", "motion", "population",
+  config.RequireOnlySections({"render", "camera", "scene", "hand", "sensor", "motion", "scenario", "population",
                               "performance", "annotator", "viewer", "self_appraisal", "study", "scorers", "montage",
                               "track", "metrics", "run", "tracker", "slider", "error_model"});
   RenderConfig c;
@@ -165,9 +155,6 @@ RenderConfig RenderConfig::FromConfig(const Config& config) {
   c.hand = config.Get<HandOptions>("hand");
   c.sensor = config.Get<KinectSensorOptions>("sensor");
   c.motion = config.Get<DemoMotionOptions>("motion");
-  c.population = config.Get<people::PopulationOptions>("population");
-  c.performance = config.Get<people::PerformanceOptions>("performance");
-  c.annotator = config.Get<people::AnnotatorOptions>("annotator");
   return c;
 }
 
@@ -179,9 +166,6 @@ nlohmann::json RenderConfig::ToJson() const {
   j["hand"] = mmh::ToJson(hand);
   j["sensor"] = mmh::ToJson(sensor);
   j["motion"] = mmh::ToJson(motion);
-  j["population"] = mmh::ToJson(population);
-  j["performance"] = mmh::ToJson(performance);
-  j["annotator"] = mmh::ToJson(annotator);
   return j;
 }
 
@@ -237,7 +221,13 @@ nlohmann::json RenderSummary::ToJson() const {
   j["write_seconds"] = write_seconds;
   j["frames_per_second"] = seconds > 0 ? frames / seconds : 0.0;
   j["missing_fraction"] = missing_fraction;
-  if (!take.is_null()) j["take"] = take;
+  if (take) {
+    j["take"] = {{"frames", take->frames},
+                 {"mean_quality", take->mean_quality},
+                 {"skill", take->skill},
+                 {"flaws", take->flaws}};
+    if (take->clipped_fraction) j["take"]["clipped_fraction"] = *take->clipped_fraction;
+  }
   j["rays"] = timings.rays;
   j["pixels_recast"] = timings.pixels_recast;
   j["seconds_per_step"] = {{"cast", timings.cast},
@@ -262,12 +252,16 @@ struct Motion {
   std::optional<people::AnnotationSession> annotation;
 };
 
-Motion ResolveMotion(const RenderConfig& config) {
+Motion ResolveMotion(const RenderConfig& config, const people::PeopleConfig& people) {
   const RenderOptions& r = config.render;
   Motion motion;
   motion.proxy = r.proxy;
-  if (!r.story.empty()) {
-    const StoryScript& script = motion.script.emplace(config, r.story, r.object, r.animator);
+  if (!people.scenario.story.empty()) {
+    if (!r.trajectory.empty()) {
+      ThrowBadValue("render.trajectory", "\"" + r.trajectory + "\"",
+                    "empty when scenario.story is given (the story's take is the motion)");
+    }
+    const StoryScript& script = motion.script.emplace(people, config.scene);
     motion.take = script.Perform(r.take);
     if (r.proxy.empty()) motion.proxy = script.ProxyFile();
     const int take_frames = motion.take->frames();
@@ -313,11 +307,11 @@ Motion ResolveMotion(const RenderConfig& config) {
 }
 
 // take.csv, flaws.csv, take.tum and participant.json of a story-driven recording.
-void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
+void WriteStoryFiles(const Motion& motion, const people::PeopleConfig& people,
                      const std::filesystem::path& out) {
   const people::PerformedTake& take = *motion.take;
   const people::StoryObject& object = motion.script->story().objects[take.object];
-  const double fps = config.performance.frame_rate;
+  const double fps = people.performance.frame_rate;
   std::string csv =
       "frame,timestamp,beat,script_kind,performed_kind,progress,quality,fidelity,path,steadiness,"
       "expression,motion";
@@ -359,12 +353,12 @@ void WriteStoryFiles(const Motion& motion, const RenderConfig& config,
 }  // namespace
 
 RenderSummary RenderSequence(
-    const RenderConfig& config, const std::filesystem::path& out,
+    const RenderConfig& config, const people::PeopleConfig& people, const std::filesystem::path& out,
     const std::function<void(int, int)>& progress,
     const std::function<void(const std::filesystem::path&, const RenderSummary&)>& before_commit) {
   const RenderOptions& r = config.render;
   // Read and check every input before the first frame.
-  const Motion motion = ResolveMotion(config);
+  const Motion motion = ResolveMotion(config, people);
   const TriangleMesh proxy_model = LoadProxyModel(motion.proxy, r.proxy_scale);
   // One scene and sensor per thread: frames render in parallel (RenderFrames) and come back in
   // order; their PNGs are encoded in parallel too. The bytes do not depend on the thread count.
@@ -443,11 +437,12 @@ RenderSummary RenderSequence(
   summary.frames = motion.frames;
   summary.missing_fraction = missing_sum / motion.frames;
   if (motion.take) {
-    summary.take = {{"frames", motion.take->frames()},
-                    {"mean_quality", motion.take->MeanQuality()},
-                    {"skill", motion.take->skill},
-                    {"flaws", motion.take->flaws.size()}};
-    if (motion.annotation) summary.take["clipped_fraction"] = motion.annotation->clipped_fraction;
+    RenderedTake& take = summary.take.emplace();
+    take.frames = motion.take->frames();
+    take.mean_quality = motion.take->MeanQuality();
+    take.skill = motion.take->skill;
+    take.flaws = static_cast<int>(motion.take->flaws.size());
+    if (motion.annotation) take.clipped_fraction = motion.annotation->clipped_fraction;
   }
   summary.timings = TotalTimings(workers);
 
@@ -469,7 +464,7 @@ RenderSummary RenderSequence(
   WritePly(proxy_model, staging / "model.ply");
   WriteAnnotationCsv(staging / "slider.csv", slider_truth);
   WriteFileAtomically(staging / "scene.json", scene_json.dump(2) + "\n");
-  if (motion.take) WriteStoryFiles(motion, config, staging);
+  if (motion.take) WriteStoryFiles(motion, people, staging);
   if (r.bop) {
     EnsureDirectory(staging / "bop" / "models");
     WriteBopScene(staging / "bop", bop, camera.depth_intrinsics, camera.depth_scale);

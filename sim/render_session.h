@@ -2,15 +2,16 @@
 // the proxy and a slider track, rendered by the Kinect model into a TUM RGB-D folder (and,
 // optionally, a fakenect dump and BOP ground truth). `mmh render` is a thin layer over this.
 //
-// The motion comes from a story performed by a simulated participant (render.story: a recording
-// session renders the take, an annotation session renders the participant annotating it with the
-// slider block while it plays), or from a TUM trajectory file (table_T_proxy) and an annotation
-// CSV, or from a built-in demo walk and slider sweep.
+// The motion comes from a story performed by a simulated participant (the config's "scenario",
+// people/scenario.h: a recording session renders the take, an annotation session renders the
+// participant annotating it with the slider block while it plays), or from a TUM trajectory file
+// (table_T_proxy) and an annotation CSV, or from a built-in demo walk and slider sweep.
 #pragma once
 
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -20,10 +21,9 @@
 #include "core/config.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
+#include "people/scenario.h"
 #include "sim/kinect_sensor.h"
-#include "people/population.h"
 #include "sim/props.h"
-#include "people/story.h"
 
 namespace mmh::sim {
 
@@ -96,12 +96,9 @@ struct RenderOptions {
   std::string annotation;
   bool hand = true;
   bool slider = true;
-  // A story (configs/stories/*.json) performed by participant `animator` of the population:
-  // take `take` of object `object`, recorded or annotated. Empty: trajectory / demo walk.
-  std::string story;
-  int animator = 0;
+  // With a story (scenario.story): take `take` of the scenario's object (0-based; the skill index:
+  // the takes a participant performed before it count), recorded or annotated.
   int take = 0;
-  int object = 0;
   RenderSession session = RenderSession::kRecording;
   // zlib level of the PNGs: 1 writes about 3.5 times faster than zlib's default 6, for files
   // 5-15 % larger with the same pixels.
@@ -120,10 +117,7 @@ struct RenderOptions {
     v("annotation", annotation);
     v("hand", hand);
     v("slider", slider);
-    v("story", story);
-    v("animator", animator);
     v("take", take);
-    v("object", object);
     v("session", session);
     v("png_compression", png_compression);
     v("fakenect", fakenect);
@@ -132,7 +126,8 @@ struct RenderOptions {
   void Validate(const std::string& prefix) const;
 };
 
-// Every section of a render config.
+// Every section of a render config: how a recording is rendered. What is performed and by whom
+// (the scenario and the people's sections) is people::PeopleConfig.
 struct RenderConfig {
   RenderOptions render;
   CameraPlacement camera;
@@ -140,12 +135,10 @@ struct RenderConfig {
   HandOptions hand;
   KinectSensorOptions sensor;
   DemoMotionOptions motion;
-  people::PopulationOptions population;
-  people::PerformanceOptions performance;
-  people::AnnotatorOptions annotator;
 
-  // Reads the render sections; the other sections of a study config (study, montage, track,
-  // metrics, viewer, scorers) may be present and are left to the commands that use them.
+  // Reads the render sections; the other sections of a run or study config (scenario and the
+  // people, study, montage, track, metrics, viewer, scorers) may be present and are left to the
+  // commands that use them.
   static RenderConfig FromConfig(const Config& config);
   nlohmann::json ToJson() const;
 };
@@ -171,14 +164,23 @@ class TableTopScene {
   double grip_height_ = 0.0;  // proxy frame z of the grasp point
 };
 
+// A story-driven recording's take.
+struct RenderedTake {
+  int frames = 0;             // the whole take's (the recording may render fewer)
+  double mean_quality = 0.0;  // of the latent quality (people/take_quality.h)
+  double skill = 0.0;         // the participant's skill at this take
+  int flaws = 0;
+  // Annotation sessions: the share of frames where the slider block sat at an end of its range.
+  std::optional<double> clipped_fraction;
+};
+
 struct RenderSummary {
   int frames = 0;
   double seconds = 0.0;           // wall clock of rendering and writing (they overlap)
   double write_seconds = 0.0;     // encoding and writing, summed over threads
   double missing_fraction = 0.0;  // mean over frames
   SensorTimings timings;
-  // Story-driven recordings: the take's length, mean latent quality and flaws.
-  nlohmann::json take;
+  std::optional<RenderedTake> take;  // story-driven recordings only
   nlohmann::json ToJson() const;
 };
 
@@ -195,7 +197,10 @@ struct RenderSummary {
 // participant.json. Everything is read and checked before the first frame; folders appear
 // complete or not at all: `before_commit(staging, summary)`, when given, adds the caller's files
 // (run.json, ...) to the staging folder before it is moved to `out`.
-RenderSummary RenderSequence(const RenderConfig& config, const std::filesystem::path& out,
+// `people` gives the scenario (people.scenario.story empty: the trajectory file or demo walk of
+// config.render).
+RenderSummary RenderSequence(const RenderConfig& config, const people::PeopleConfig& people,
+                             const std::filesystem::path& out,
                              const std::function<void(int, int)>& progress = {},
                              const std::function<void(const std::filesystem::path&,
                                                       const RenderSummary&)>& before_commit = {});

@@ -13,19 +13,23 @@ constexpr double kRestingProxyX = -0.32;
 
 }  // namespace
 
-StoryScript::StoryScript(const RenderConfig& config, const std::string& story_file, int object,
-                         int animator, const std::string& object_key)
-    : config_(&config),
+StoryScript::StoryScript(const people::PeopleConfig& people, const TableSceneOptions& scene)
+    : StoryScript(people, scene, people.scenario.story, people.scenario.object, "scenario.object") {}
+
+StoryScript::StoryScript(const people::PeopleConfig& people, const TableSceneOptions& scene,
+                         const std::string& story_file, int object, const std::string& object_key)
+    : people_(&people),
       story_file_(story_file),
-      story_(people::LoadStory(story_file, config.scene)),
+      story_(people::LoadStory(story_file, scene)),
       object_(object) {
   if (object < 0 || object >= static_cast<int>(story_.objects.size())) {
     ThrowBadValue(object_key, std::to_string(object),
                   "an object of " + story_file + " (0.." +
                       std::to_string(story_.objects.size() - 1) + ")");
   }
-  if (animator < 0) ThrowBadValue("animator", std::to_string(animator), "an index >= 0");
-  participant_ = people::DrawParticipant(config.population, animator);
+  const int animator = people.scenario.animator;
+  if (animator < 0) ThrowBadValue("scenario.animator", std::to_string(animator), "an index >= 0");
+  participant_ = people::DrawParticipant(people.population, animator);
 }
 
 std::string StoryScript::ProxyFile() const {
@@ -37,14 +41,14 @@ std::string StoryScript::ProxyFile() const {
 }
 
 people::PerformedTake StoryScript::Perform(int take) const {
-  return people::PerformTake(story_, object_, participant_.animator, take, config_->performance,
-                     people::ParticipantSeed(config_->population, participant_.index));
+  return people::PerformTake(story_, object_, participant_.animator, take, people_->performance,
+                     people::ParticipantSeed(people_->population, participant_.index));
 }
 
 people::AnnotationSession StoryScript::Annotate(const people::PerformedTake& take) const {
-  people::AnnotatorOptions annotator = config_->annotator;
-  annotator.frame_rate = config_->performance.frame_rate;
-  const std::uint64_t seed = people::ParticipantSeed(config_->population, participant_.index);
+  people::AnnotatorOptions annotator = people_->annotator;
+  annotator.frame_rate = people_->performance.frame_rate;
+  const std::uint64_t seed = people::ParticipantSeed(people_->population, participant_.index);
   return people::AnnotateTake(take.quality.quality, participant_.annotator, annotator,
                       people::DeriveSeed(seed, {0x616eull, static_cast<std::uint64_t>(take.object),
                                         static_cast<std::uint64_t>(take.take)}));
@@ -54,7 +58,7 @@ SessionFrames StoryScript::RecordingFrames(const people::PerformedTake& take, in
   SessionFrames s;
   s.table_T_proxy.assign(take.table_T_proxy.poses.begin(),
                          take.table_T_proxy.poses.begin() + frames);
-  s.slider.assign(frames, config_->annotator.start_value);
+  s.slider.assign(frames, people_->annotator.start_value);
   return s;
 }
 

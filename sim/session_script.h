@@ -11,9 +11,7 @@
 #include <vector>
 
 #include "core/rigid3.h"
-#include "people/annotator.h"
-#include "people/performance.h"
-#include "people/population.h"
+#include "people/scenario.h"
 #include "people/story.h"
 #include "sim/render_session.h"
 
@@ -28,11 +26,13 @@ struct SessionFrames {
 
 class StoryScript {
  public:
+  // The scenario's story and object (people.scenario), performed by its participant.
+  StoryScript(const people::PeopleConfig& people, const TableSceneOptions& scene);
   // Loads and checks `story_file` (InputError naming the file) and the object (InputError naming
-  // `object_key` and the story's objects), and draws participant `animator` of
-  // config.population.
-  StoryScript(const RenderConfig& config, const std::string& story_file, int object, int animator,
-              const std::string& object_key = "render.object");
+  // `object_key` and the story's objects), performed by the scenario's participant
+  // (people.scenario.animator of people.population). `people` must outlive the script.
+  StoryScript(const people::PeopleConfig& people, const TableSceneOptions& scene,
+              const std::string& story_file, int object, const std::string& object_key);
 
   const people::Story& story() const { return story_; }
   int object() const { return object_; }
@@ -52,7 +52,7 @@ class StoryScript {
   SessionFrames AnnotationFrames(const people::AnnotationSession& annotation, int frames) const;
 
  private:
-  const RenderConfig* config_;
+  const people::PeopleConfig* people_;
   std::string story_file_;
   people::Story story_;
   int object_;

@@ -276,10 +276,12 @@ nlohmann::json MixedModelResult::ToJson() const {
   return j;
 }
 
-MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<const int> level,
-                                         std::span<const double> y,
-                                         const MixedModelOptions& options) {
-  options.Validate("mixed model options");
+namespace {
+
+// The data as the REML algebra needs it, checked: InputError for anything lme4 would refuse.
+// *balanced: every group has every level exactly once.
+Design MakeDesign(std::span<const int> group, std::span<const int> level,
+                  std::span<const double> y, bool* balanced) {
   if (group.size() != y.size() || level.size() != y.size()) {
     ThrowBadValue("mixed model data",
                   std::to_string(y.size()) + " scores, " + std::to_string(group.size()) +
@@ -345,14 +347,14 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
     }
   }
 
-  MixedModelResult r;
-  r.summary.observations = d.n;
-  r.summary.groups = d.m;
-  r.summary.levels = d.p;
-  r.summary.balanced = (cell_count.array() == 1).all();
+  *balanced = (cell_count.array() == 1).all();
+  return d;
+}
 
-  // The REML optimum: psi = 0 if the criterion rises from there, and every interior root of the
-  // score where it turns from negative to positive; the smallest criterion wins.
+// psi = theta^2 at the REML optimum: psi = 0 if the criterion rises from there, and every
+// interior root of the score where it turns from negative to positive; the smallest criterion
+// wins.
+double RemlOptimum(const Design& d, const MixedModelOptions& options, int* evaluations) {
   std::vector<double> grid = {0.0};
   const int per_decade = options.grid_points_per_decade;
   for (int i = 0; i <= 20 * per_decade; ++i) {
@@ -366,13 +368,13 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
                     "scores that the fixed effects do not fit exactly (constant within takes?)");
     }
     scores.push_back(ev.score);
-    ++r.summary.score_evaluations;
+    ++*evaluations;
   }
   std::vector<double> candidates;
   if (scores[0] >= 0.0) candidates.push_back(0.0);
   for (std::size_t i = 0; i + 1 < grid.size(); ++i) {
     if (scores[i] < 0.0 && scores[i + 1] >= 0.0) {
-      candidates.push_back(BisectScore(d, grid[i], grid[i + 1], &r.summary.score_evaluations));
+      candidates.push_back(BisectScore(d, grid[i], grid[i + 1], evaluations));
     }
   }
   if (candidates.empty()) {
@@ -391,34 +393,35 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
     }
   }
 
-  const Evaluation ev = Evaluate(d, psi);
+  return psi;
+}
+
+// lmerTest's Satterthwaite machinery, with exact derivatives: the asymptotic covariance of the
+// variance parameters (theta, sigma) and the Jacobian of vcov(beta) in them.
+struct Satterthwaite {
+  Eigen::Matrix2d varpar_covariance;
+  Eigen::MatrixXd jac_theta;
+  Eigen::MatrixXd jac_sigma;
+
+  // One-dimensional Satterthwaite df of a contrast l: 2 (l'Vl)^2 / (g'A g), g the gradient of
+  // l'Vl in (theta, sigma) (lmerTest's contest1D).
+  double Df(const Eigen::RowVectorXd& l, double variance) const {
+    const Eigen::Vector2d gradient(l * jac_theta * l.transpose(), l * jac_sigma * l.transpose());
+    const double v = gradient.dot(varpar_covariance * gradient);
+    return v > 0.0 ? 2.0 * variance * variance / v : std::numeric_limits<double>::infinity();
+  }
+};
+
+// Deviance in (theta, sigma):
+//   D = f(theta^2, sigma), f = log|V| + log|M| + r2(psi) / sigma^2 + (N - p) log(2 pi sigma^2),
+// f_psi = tr(S) - |s|^2 / sigma^2, f_psipsi = -|S|_F^2 + 2 s'S s / sigma^2,
+// f_psisigma = 2 |s|^2 / sigma^3, f_sigmasigma = 6 r2 / sigma^4 - 2 (N - p) / sigma^2.
+// Warnings about the Hessian's eigenvalues go to r.summary.
+Satterthwaite MakeSatterthwaite(const Design& d, const Evaluation& ev,
+                                const MixedModelOptions& options, MixedModelResult& r) {
+  const Eigen::Index m = static_cast<Eigen::Index>(d.m);
+  const double psi = ev.psi;
   const double residual_df = static_cast<double>(d.n - d.p);
-  r.boundary = psi == 0.0;
-  r.theta = std::sqrt(psi);
-  r.residual_variance = ev.r2 / residual_df;
-  r.sigma = std::sqrt(r.residual_variance);
-  r.group_variance = psi * r.residual_variance;
-  r.icc = r.group_variance / (r.group_variance + r.residual_variance);
-  r.reml_criterion = ev.criterion;
-  r.beta = ev.beta;
-  r.beta_covariance = r.residual_variance * ev.m_inverse;
-
-  // Random intercepts (conditional modes) and conditional residuals.
-  r.random_effects.resize(d.m);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    r.random_effects[i] = psi / (1.0 + d.group_size(i) * psi) * ev.group_residual(i);
-  }
-  r.fitted.resize(d.n);
-  r.residuals.resize(d.n);
-  for (std::size_t j = 0; j < d.n; ++j) {
-    r.residuals[j] = ev.residual(j) - r.random_effects[group[j]];
-    r.fitted[j] = y[j] - r.residuals[j];
-  }
-
-  // lmerTest's Satterthwaite machinery, with exact derivatives. Deviance in (theta, sigma):
-  //   D = f(theta^2, sigma), f = log|V| + log|M| + r2(psi) / sigma^2 + (N - p) log(2 pi sigma^2),
-  // f_psi = tr(S) - |s|^2 / sigma^2, f_psipsi = -|S|_F^2 + 2 s'S s / sigma^2,
-  // f_psisigma = 2 |s|^2 / sigma^3, f_sigmasigma = 6 r2 / sigma^4 - 2 (N - p) / sigma^2.
   const double sigma = r.sigma;
   const double sigma2 = r.residual_variance;
   const double s_norm2 = ev.s.squaredNorm();
@@ -459,19 +462,19 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
       hessian_pinv += v * v.transpose() / value;
     }
   }
-  const Eigen::Matrix2d varpar_covariance = 2.0 * hessian_pinv;
+  Satterthwaite out;
+  out.varpar_covariance = 2.0 * hessian_pinv;
   // Jacobian of vcov(beta) = sigma^2 M^-1(theta^2): d/dtheta = sigma^2 2 theta M^-1 W'W M^-1,
   // d/dsigma = 2 sigma M^-1.
-  const Eigen::MatrixXd jac_theta = sigma2 * 2.0 * r.theta * ev.m_inverse * wtw * ev.m_inverse;
-  const Eigen::MatrixXd jac_sigma = 2.0 * sigma * ev.m_inverse;
+  out.jac_theta = sigma2 * 2.0 * r.theta * ev.m_inverse * wtw * ev.m_inverse;
+  out.jac_sigma = 2.0 * sigma * ev.m_inverse;
+  return out;
+}
 
-  // One-dimensional Satterthwaite df of a contrast l: 2 (l'Vl)^2 / (g'A g), g the gradient of
-  // l'Vl in (theta, sigma) (lmerTest's contest1D).
-  const auto satterthwaite = [&](const Eigen::RowVectorXd& l, double variance) {
-    const Eigen::Vector2d gradient(l * jac_theta * l.transpose(), l * jac_sigma * l.transpose());
-    const double v = gradient.dot(varpar_covariance * gradient);
-    return v > 0.0 ? 2.0 * variance * variance / v : std::numeric_limits<double>::infinity();
-  };
+// The fixed effects with Satterthwaite df, t, p and confidence intervals (lmerTest's summary).
+void SetFixedEffects(const Satterthwaite& satterthwaite, const MixedModelOptions& options,
+                     MixedModelResult& r) {
+  const Eigen::Index p = r.beta.size();
   for (Eigen::Index j = 0; j < p; ++j) {
     FixedEffect e;
     e.name = j == 0 ? "(Intercept)" : "take" + std::to_string(j + 1);
@@ -479,7 +482,7 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
     const double variance = r.beta_covariance(j, j);
     e.estimate = r.beta(j);
     e.standard_error = std::sqrt(variance);
-    e.df = satterthwaite(l, variance);
+    e.df = satterthwaite.Df(l, variance);
     e.t = e.estimate / e.standard_error;
     double half = 0.0;
     if (std::isfinite(e.df)) {
@@ -494,9 +497,13 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
     e.conf_int = {e.estimate - half, e.estimate + half, options.conf_level};
     r.fixed_effects.push_back(e);
   }
+}
 
-  // Contrast of the take effect: lmerTest uses type I contrasts for a model with one term (its
-  // type III reduces to them), the rows of t(doolittle(X'X)$L) of the take columns.
+// The F test of the take effect: lmerTest uses type I contrasts for a model with one term (its
+// type III reduces to them), the rows of t(doolittle(X'X)$L) of the take columns.
+void SetTakeTest(const Design& d, const Satterthwaite& satterthwaite, MixedModelResult& r) {
+  const Eigen::Index p = static_cast<Eigen::Index>(d.p);
+  const double sigma2 = r.residual_variance;
   r.contrast = DoolittleL(d.xtx).transpose().bottomRows(p - 1);
   const Eigen::MatrixXd vl = r.contrast * r.beta_covariance * r.contrast.transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> vl_eigen(vl);
@@ -513,12 +520,20 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
     const Eigen::RowVectorXd direction = vl_eigen.eigenvectors().col(idx).transpose() * r.contrast;
     const double estimate = direction.dot(r.beta);
     t2_sum += estimate * estimate / value;
-    r.direction_df.push_back(satterthwaite(direction, value));
+    r.direction_df.push_back(satterthwaite.Df(direction, value));
   }
   const double q = static_cast<double>(r.direction_df.size());
   const double f = t2_sum / q;
   r.take_test = MakeFTest(f, q, CombineDf(r.direction_df), f * sigma2 * q);
+}
 
+// The repeated-measures ANOVA of a balanced design, which the mixed model's F test must equal
+// when the animator variance is interior; warnings when it is undefined or differs.
+void CompareWithRmAnova(const Design& d, MixedModelResult& r) {
+  const Eigen::Index p = static_cast<Eigen::Index>(d.p);
+  const std::span<const int> group = d.group;
+  const std::span<const int> level = d.level;
+  const std::span<const double> y = d.y;
   if (r.summary.balanced) {
     // Two-way layout without replication: SS_take = n sum_j (mean_j - mean)^2, SS_error = sum
     // (y_ij - mean_i - mean_j + mean)^2, F = (SS_take / (k - 1)) / (SS_error / ((n - 1)(k - 1))).
@@ -568,6 +583,50 @@ MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<c
                                  " differs from the repeated-measures ANOVA " +
                                  Describe(*r.rm_anova));
   }
+}
+
+}  // namespace
+
+MixedModelResult FitRandomInterceptModel(std::span<const int> group, std::span<const int> level,
+                                         std::span<const double> y,
+                                         const MixedModelOptions& options) {
+  options.Validate("mixed model options");
+  MixedModelResult r;
+  const Design d = MakeDesign(group, level, y, &r.summary.balanced);
+  r.summary.observations = d.n;
+  r.summary.groups = d.m;
+  r.summary.levels = d.p;
+  const double psi = RemlOptimum(d, options, &r.summary.score_evaluations);
+
+  const Eigen::Index m = static_cast<Eigen::Index>(d.m);
+  const Evaluation ev = Evaluate(d, psi);
+  const double residual_df = static_cast<double>(d.n - d.p);
+  r.boundary = psi == 0.0;
+  r.theta = std::sqrt(psi);
+  r.residual_variance = ev.r2 / residual_df;
+  r.sigma = std::sqrt(r.residual_variance);
+  r.group_variance = psi * r.residual_variance;
+  r.icc = r.group_variance / (r.group_variance + r.residual_variance);
+  r.reml_criterion = ev.criterion;
+  r.beta = ev.beta;
+  r.beta_covariance = r.residual_variance * ev.m_inverse;
+
+  // Random intercepts (conditional modes) and conditional residuals.
+  r.random_effects.resize(d.m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    r.random_effects[i] = psi / (1.0 + d.group_size(i) * psi) * ev.group_residual(i);
+  }
+  r.fitted.resize(d.n);
+  r.residuals.resize(d.n);
+  for (std::size_t j = 0; j < d.n; ++j) {
+    r.residuals[j] = ev.residual(j) - r.random_effects[group[j]];
+    r.fitted[j] = y[j] - r.residuals[j];
+  }
+
+  const Satterthwaite satterthwaite = MakeSatterthwaite(d, ev, options, r);
+  SetFixedEffects(satterthwaite, options, r);
+  SetTakeTest(d, satterthwaite, r);
+  CompareWithRmAnova(d, r);
   return r;
 }
 

@@ -89,6 +89,10 @@ StudyConfig StudyConfig::FromConfig(const Config& config) {
   out.scorers = config.Get<ScorerOptions>("scorers");
   out.viewer = config.Get<people::ViewerOptions>("viewer");
   out.self_appraisal = config.Get<people::SelfAppraisalOptions>("self_appraisal");
+  if (out.run.people.scenario.animator != 0) {
+    ThrowBadValue("scenario.animator", std::to_string(out.run.people.scenario.animator),
+                  "0 (mmh study runs participants 0 .. study.animators - 1; mmh run runs one)");
+  }
   // Checked here so that a bad design fails before any animator runs.
   ScorerCount(out.scorers, out.study.animators, out.run.run.takes);
   return out;
@@ -107,8 +111,8 @@ StudyConfig StudyConfig::ForReplicate(int replicate) const {
   StudyConfig out = *this;
   if (replicate == 0) return out;
   const auto r = static_cast<std::uint64_t>(replicate);
-  out.run.render.population.seed =
-      people::DeriveSeed(run.render.population.seed, {kReplicatePopulation, r});
+  out.run.people.population.seed =
+      people::DeriveSeed(run.people.population.seed, {kReplicatePopulation, r});
   out.study.seed = people::DeriveSeed(study.seed, {kReplicateScoring, r});
   // Only replicate 0's animators are written out (results.json, animators.csv).
   out.run.run.metrics = false;
@@ -160,7 +164,7 @@ SimulatedStudy RunSimulatedStudy(const StudyConfig& config, int replicate,
   // their slot, so the order (and every number) is independent of the thread count.
   tbb::parallel_for(0, n, [&](int i) {
     try {
-      study.animators[i] = Summarise(config, i, pipeline::RunAnimator(config.run, i));
+      study.animators[i] = Summarise(config, i, pipeline::RunAnimator(config.run.ForAnimator(i)));
     } catch (const pipeline::RunError& e) {
       throw pipeline::RunError("animator " + AnimatorId(i) + " (participant " + std::to_string(i) +
                                "): " + e.what());

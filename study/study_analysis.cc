@@ -210,36 +210,44 @@ nlohmann::json SegmentConstraintAnalysis::ToJson() const {
           {"threshold_scale", threshold_scale}};
 }
 
-StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& options) {
-  options.Validate("stats");
-  ValidateStudyData(data, options.data);
-  StudyAnalysis a;
-  a.options = options;
-  StudySummary& summary = a.summary;
+namespace {
 
-  // ---- rankings: Friedman over animators (blocks) x items (groups) ----
-  {
-    std::map<std::string, std::map<std::string, double>> ranks;  // animator -> item -> rank
-    std::set<std::string> items;
-    for (const auto& r : data.rankings) {
-      ranks[r.animator][r.item] = r.rank;
-      items.insert(r.item);
-    }
-    a.rankings.items.assign(items.begin(), items.end());
-    summary.ranking_animators = ranks.size();
-    Eigen::MatrixXd y(static_cast<Eigen::Index>(ranks.size()),
-                      static_cast<Eigen::Index>(items.size()));
-    Eigen::Index i = 0;
-    for (const auto& [animator, by_item] : ranks) {
-      Eigen::Index j = 0;
-      for (const auto& item : a.rankings.items) y(i, j++) = by_item.at(item);
-      ++i;
-    }
-    a.rankings.friedman = Attempt<stats::FriedmanResult>("Friedman test", &summary,
-                                                         [&] { return stats::FriedmanTest(y); });
+// A one-sample t-test against `mu` with the analysis's alternative and confidence level.
+stats::TTestOptions OneSampleTTestOptions(double mu, const StudyAnalysisOptions& options) {
+  stats::TTestOptions t;
+  t.mu = mu;
+  t.alternative = options.alternative;
+  t.conf_level = options.conf_level;
+  return t;
+}
+
+// The animators' rankings of their takes and the montage: Friedman over animators (blocks) x
+// items (groups).
+void AnalyzeRankings(const StudyData& data, StudyAnalysis& a) {
+  std::map<std::string, std::map<std::string, double>> ranks;  // animator -> item -> rank
+  std::set<std::string> items;
+  for (const auto& r : data.rankings) {
+    ranks[r.animator][r.item] = r.rank;
+    items.insert(r.item);
   }
+  a.rankings.items.assign(items.begin(), items.end());
+  a.summary.ranking_animators = ranks.size();
+  Eigen::MatrixXd y(static_cast<Eigen::Index>(ranks.size()),
+                    static_cast<Eigen::Index>(items.size()));
+  Eigen::Index i = 0;
+  for (const auto& [animator, by_item] : ranks) {
+    Eigen::Index j = 0;
+    for (const auto& item : a.rankings.items) y(i, j++) = by_item.at(item);
+    ++i;
+  }
+  a.rankings.friedman = Attempt<stats::FriedmanResult>("Friedman test", &a.summary,
+                                                       [&] { return stats::FriedmanTest(y); });
+}
 
-  // ---- m_ij ----
+// m_ij: the share of comparisons in which animator i's montage was preferred over their take j
+// (paper, "Results"), with the study's counts in the summary.
+void ScoreTakes(const StudyData& data, StudyAnalysis& a) {
+  StudySummary& summary = a.summary;
   std::map<std::pair<std::string, int>, TakeScore> cells;
   std::set<std::string> scorers;
   std::set<std::string> animators;
@@ -268,167 +276,183 @@ StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& op
                                " comparisons by a scorer of their own animation (the paper "
                                "excluded these)");
   }
-  const int k = summary.takes;
+}
 
-  // ---- H1 ----
-  {
-    std::vector<double> sample;
-    if (options.h1_unit == H1Unit::kTakeScores) {
-      for (const auto& s : a.take_scores) sample.push_back(s.m);
-    } else {
-      std::map<std::string, std::vector<double>> per_animator;
-      for (const auto& s : a.take_scores) per_animator[s.animator].push_back(s.m);
-      for (const auto& [animator, ms] : per_animator) sample.push_back(stats::Mean(ms));
-    }
-    a.h1.mean_m = stats::Mean(sample);
-    a.h1.sd_m = sample.size() > 1 ? std::sqrt(stats::Variance(sample)) : NAN;
-    stats::TTestOptions t;
-    t.mu = options.chance;
-    t.alternative = options.alternative;
-    t.conf_level = options.conf_level;
-    a.h1.t_test = Attempt<stats::TTestResult>("H1 t-test", &summary,
-                                              [&] { return stats::OneSampleTTest(sample, t); });
-    const std::vector<double> counts = {static_cast<double>(a.h1.wins),
-                                        static_cast<double>(a.h1.comparisons - a.h1.wins)};
-    const std::vector<double> p = {options.chance, 1.0 - options.chance};
-    a.h1.chi_squared = Attempt<stats::ChiSquaredResult>(
-        "H1 chi-squared test", &summary, [&] { return stats::ChiSquaredGoodnessOfFit(counts, p); });
-    stats::BinomialTestOptions b;
-    b.p = options.chance;
-    b.alternative = options.alternative;
-    b.conf_level = options.conf_level;
-    a.h1.binomial = Attempt<stats::BinomialTestResult>("H1 binomial test", &summary, [&] {
-      return stats::BinomialTest(static_cast<std::int64_t>(a.h1.wins),
-                                 static_cast<std::int64_t>(a.h1.comparisons), b);
-    });
+// H1: the montage is preferred over a take more often than by chance (t-test of the m_ij or of
+// the animators' means, chi-squared and exact binomial test of the wins).
+void AnalyzeH1(const StudyAnalysisOptions& options, StudyAnalysis& a) {
+  std::vector<double> sample;
+  if (options.h1_unit == H1Unit::kTakeScores) {
+    for (const auto& s : a.take_scores) sample.push_back(s.m);
+  } else {
+    std::map<std::string, std::vector<double>> per_animator;
+    for (const auto& s : a.take_scores) per_animator[s.animator].push_back(s.m);
+    for (const auto& [animator, ms] : per_animator) sample.push_back(stats::Mean(ms));
   }
+  a.h1.mean_m = stats::Mean(sample);
+  a.h1.sd_m = sample.size() > 1 ? std::sqrt(stats::Variance(sample)) : NAN;
+  const stats::TTestOptions t = OneSampleTTestOptions(options.chance, options);
+  a.h1.t_test = Attempt<stats::TTestResult>("H1 t-test", &a.summary,
+                                            [&] { return stats::OneSampleTTest(sample, t); });
+  const std::vector<double> counts = {static_cast<double>(a.h1.wins),
+                                      static_cast<double>(a.h1.comparisons - a.h1.wins)};
+  const std::vector<double> p = {options.chance, 1.0 - options.chance};
+  a.h1.chi_squared = Attempt<stats::ChiSquaredResult>(
+      "H1 chi-squared test", &a.summary, [&] { return stats::ChiSquaredGoodnessOfFit(counts, p); });
+  stats::BinomialTestOptions b;
+  b.p = options.chance;
+  b.alternative = options.alternative;
+  b.conf_level = options.conf_level;
+  a.h1.binomial = Attempt<stats::BinomialTestResult>("H1 binomial test", &a.summary, [&] {
+    return stats::BinomialTest(static_cast<std::int64_t>(a.h1.wins),
+                               static_cast<std::int64_t>(a.h1.comparisons), b);
+  });
+}
 
-  // ---- H2: b_i over animators with every take ----
-  {
-    std::map<std::string, std::vector<const TakeScore*>> per_animator;
-    for (const auto& s : a.take_scores) per_animator[s.animator].push_back(&s);
-    std::vector<double> b;
-    std::size_t incomplete = 0;
-    for (const auto& [animator, scores] : per_animator) {
-      if (static_cast<int>(scores.size()) != k) {
-        ++incomplete;
-        continue;
-      }
-      double product = 1.0;
-      for (const auto* s : scores) product *= s->m;
-      a.h2.b.emplace_back(animator, product);
-      b.push_back(product);
+// H2: b_i = prod_j m_ij, over the animators with comparisons of every take, above the chance of
+// preferring the montage over all takes.
+void AnalyzeH2(const StudyAnalysisOptions& options, StudyAnalysis& a) {
+  const int k = a.summary.takes;
+  std::map<std::string, std::vector<const TakeScore*>> per_animator;
+  for (const auto& s : a.take_scores) per_animator[s.animator].push_back(&s);
+  std::vector<double> b;
+  std::size_t incomplete = 0;
+  for (const auto& [animator, scores] : per_animator) {
+    if (static_cast<int>(scores.size()) != k) {
+      ++incomplete;
+      continue;
     }
-    if (incomplete > 0) {
-      summary.warnings.push_back("H2 leaves out " + std::to_string(incomplete) +
+    double product = 1.0;
+    for (const auto* s : scores) product *= s->m;
+    a.h2.b.emplace_back(animator, product);
+    b.push_back(product);
+  }
+  if (incomplete > 0) {
+    a.summary.warnings.push_back("H2 leaves out " + std::to_string(incomplete) +
                                  " animators without comparisons of all " + std::to_string(k) +
                                  " takes");
-    }
-    a.h2.normality = Attempt<stats::ShapiroWilkResult>("H2 Shapiro-Wilk test", &summary,
-                                                       [&] { return stats::ShapiroWilkTest(b); });
-    stats::TTestOptions t;
-    t.mu = options.all_takes_chance;
-    t.alternative = options.alternative;
-    t.conf_level = options.conf_level;
-    a.h2.t_test = Attempt<stats::TTestResult>("H2 t-test", &summary,
-                                              [&] { return stats::OneSampleTTest(b, t); });
   }
+  a.h2.normality = Attempt<stats::ShapiroWilkResult>("H2 Shapiro-Wilk test", &a.summary,
+                                                     [&] { return stats::ShapiroWilkTest(b); });
+  const stats::TTestOptions t = OneSampleTTestOptions(options.all_takes_chance, options);
+  a.h2.t_test = Attempt<stats::TTestResult>("H2 t-test", &a.summary,
+                                            [&] { return stats::OneSampleTTest(b, t); });
+}
 
-  // ---- H3: m_ij ~ take + (1 | animator) ----
-  {
-    std::map<std::string, int> animator_index;
-    for (const auto& s : a.take_scores) animator_index.emplace(s.animator, 0);
-    int next = 0;
-    for (auto& [name, index] : animator_index) index = next++;
-    std::vector<int> group;
-    std::vector<int> level;
-    std::vector<double> y;
-    std::vector<std::vector<double>> by_take(static_cast<std::size_t>(k));
-    for (const auto& s : a.take_scores) {
-      group.push_back(animator_index.at(s.animator));
-      level.push_back(s.take - 1);
-      y.push_back(s.m);
-      by_take[s.take - 1].push_back(s.m);
-    }
-    for (const auto& ms : by_take) {
-      a.h3.take_means.push_back(stats::Mean(ms));
-      a.h3.take_standard_errors.push_back(
-          ms.size() > 1 ? std::sqrt(stats::Variance(ms) / static_cast<double>(ms.size())) : NAN);
-    }
-    a.h3.mixed_model = Attempt<stats::MixedModelResult>("H3 mixed model", &summary, [&] {
-      return stats::FitRandomInterceptModel(group, level, y, options.mixed_model);
-    });
-    if (a.h3.mixed_model.result) {
-      for (const auto& w : a.h3.mixed_model.result->summary.warnings) {
-        summary.warnings.push_back("H3 mixed model: " + w);
-      }
-      a.h3.residual_normality = Attempt<stats::ShapiroWilkResult>(
-          "H3 residual Shapiro-Wilk test", &summary,
-          [&] { return stats::ShapiroWilkTest(a.h3.mixed_model.result->residuals); });
-    } else {
-      a.h3.residual_normality.not_computed = "no mixed model";
-    }
-    Eigen::MatrixXd table = Eigen::MatrixXd::Zero(k, 2);
-    for (const auto& c : data.comparisons) table(c.take - 1, c.montage_preferred ? 0 : 1) += 1.0;
-    a.h3.take_table = Attempt<stats::ChiSquaredResult>("H3 take x preference table", &summary, [&] {
-      return stats::ChiSquaredIndependence(table, options.yates);
-    });
+// H3: take order, m_ij ~ take + (1 | animator), its residuals' normality, and the take x
+// preference table.
+void AnalyzeH3(const StudyData& data, const StudyAnalysisOptions& options, StudyAnalysis& a) {
+  const int k = a.summary.takes;
+  std::map<std::string, int> animator_index;
+  for (const auto& s : a.take_scores) animator_index.emplace(s.animator, 0);
+  int next = 0;
+  for (auto& [name, index] : animator_index) index = next++;
+  std::vector<int> group;
+  std::vector<int> level;
+  std::vector<double> y;
+  std::vector<std::vector<double>> by_take(static_cast<std::size_t>(k));
+  for (const auto& s : a.take_scores) {
+    group.push_back(animator_index.at(s.animator));
+    level.push_back(s.take - 1);
+    y.push_back(s.m);
+    by_take[s.take - 1].push_back(s.m);
   }
+  for (const auto& ms : by_take) {
+    a.h3.take_means.push_back(stats::Mean(ms));
+    a.h3.take_standard_errors.push_back(
+        ms.size() > 1 ? std::sqrt(stats::Variance(ms) / static_cast<double>(ms.size())) : NAN);
+  }
+  a.h3.mixed_model = Attempt<stats::MixedModelResult>("H3 mixed model", &a.summary, [&] {
+    return stats::FitRandomInterceptModel(group, level, y, options.mixed_model);
+  });
+  if (a.h3.mixed_model.result) {
+    for (const auto& w : a.h3.mixed_model.result->summary.warnings) {
+      a.summary.warnings.push_back("H3 mixed model: " + w);
+    }
+    a.h3.residual_normality = Attempt<stats::ShapiroWilkResult>(
+        "H3 residual Shapiro-Wilk test", &a.summary,
+        [&] { return stats::ShapiroWilkTest(a.h3.mixed_model.result->residuals); });
+  } else {
+    a.h3.residual_normality.not_computed = "no mixed model";
+  }
+  Eigen::MatrixXd table = Eigen::MatrixXd::Zero(k, 2);
+  for (const auto& c : data.comparisons) table(c.take - 1, c.montage_preferred ? 0 : 1) += 1.0;
+  a.h3.take_table = Attempt<stats::ChiSquaredResult>("H3 take x preference table", &a.summary, [&] {
+    return stats::ChiSquaredIndependence(table, options.yates);
+  });
+}
 
-  // ---- Segment Length Constraint ----
-  if (!data.segment_costs.empty()) {
-    SegmentConstraintAnalysis s;
-    double sum = 0.0, paper_sum = 0.0;
-    bool paper_scale = true;  // every animator with short segments has reference_frames
-    bool relative_below = true, paper_below = true;
-    double paper_max = 0.0, per_frame_max = 0.0;
-    for (const auto& row : data.segment_costs) {
-      SegmentConstraintAnalysis::Animator an;
-      an.animator = row.animator;
-      an.short_segments_unconstrained = row.short_segments_unconstrained;
-      an.increase = row.cost_constrained - row.cost_unconstrained;
-      an.increase_percent = row.cost_unconstrained == 0.0
-                                ? 0.0
-                                : 100.0 * an.increase / std::abs(row.cost_unconstrained);
-      if (row.reference_frames > 0) {
-        const double n = row.reference_frames;
-        const double shifted = row.cost_unconstrained + kMaxAnnotation * n;
-        if (shifted > 0) an.paper_scale_percent = 100.0 * an.increase / shifted;
-        an.increase_per_frame = an.increase / n;
-      }
-      if (an.short_segments_unconstrained > 0) {
-        ++s.animators_with_short_segments;
-        s.max_increase_percent = std::max(s.max_increase_percent, an.increase_percent);
-        sum += an.increase_percent;
-        relative_below =
-            relative_below && an.increase_percent < options.cost_increase_threshold_percent;
-        if (an.paper_scale_percent) {
-          paper_max = std::max(paper_max, *an.paper_scale_percent);
-          per_frame_max = std::max(per_frame_max, *an.increase_per_frame);
-          paper_sum += *an.paper_scale_percent;
-          paper_below =
-              paper_below && *an.paper_scale_percent < options.cost_increase_threshold_percent;
-        } else {
-          paper_scale = false;
-        }
-      }
-      s.animators.push_back(an);
+// The Segment Length Constraint's cost (eqs. 7-12): the increase of the labelling's cost over
+// the unconstrained optimum, relative to |unconstrained cost| and on the paper's scale (the
+// annotation shifted to be non-negative, kMaxAnnotation per reference frame).
+SegmentConstraintAnalysis AnalyzeSegmentConstraint(const StudyData& data,
+                                                   const StudyAnalysisOptions& options) {
+  SegmentConstraintAnalysis s;
+  double sum = 0.0, paper_sum = 0.0;
+  bool paper_scale = true;  // every animator with short segments has reference_frames
+  bool relative_below = true, paper_below = true;
+  double paper_max = 0.0, per_frame_max = 0.0;
+  for (const auto& row : data.segment_costs) {
+    SegmentConstraintAnalysis::Animator an;
+    an.animator = row.animator;
+    an.short_segments_unconstrained = row.short_segments_unconstrained;
+    an.increase = row.cost_constrained - row.cost_unconstrained;
+    an.increase_percent = row.cost_unconstrained == 0.0
+                              ? 0.0
+                              : 100.0 * an.increase / std::abs(row.cost_unconstrained);
+    if (row.reference_frames > 0) {
+      const double n = row.reference_frames;
+      const double shifted = row.cost_unconstrained + kMaxAnnotation * n;
+      if (shifted > 0) an.paper_scale_percent = 100.0 * an.increase / shifted;
+      an.increase_per_frame = an.increase / n;
     }
-    std::sort(s.animators.begin(), s.animators.end(),
-              [](const auto& x, const auto& y) { return x.animator < y.animator; });
-    const std::size_t k = s.animators_with_short_segments;
-    s.mean_increase_percent = k ? sum / k : 0.0;
-    if (paper_scale) {
-      s.max_paper_scale_percent = paper_max;
-      s.mean_paper_scale_percent = k ? paper_sum / k : 0.0;
-      s.max_increase_per_frame = per_frame_max;
-      s.all_below_threshold = paper_below;
-      s.threshold_scale = "paper";
-    } else {
-      s.all_below_threshold = relative_below;
+    if (an.short_segments_unconstrained > 0) {
+      ++s.animators_with_short_segments;
+      s.max_increase_percent = std::max(s.max_increase_percent, an.increase_percent);
+      sum += an.increase_percent;
+      relative_below =
+          relative_below && an.increase_percent < options.cost_increase_threshold_percent;
+      if (an.paper_scale_percent) {
+        paper_max = std::max(paper_max, *an.paper_scale_percent);
+        per_frame_max = std::max(per_frame_max, *an.increase_per_frame);
+        paper_sum += *an.paper_scale_percent;
+        paper_below =
+            paper_below && *an.paper_scale_percent < options.cost_increase_threshold_percent;
+      } else {
+        paper_scale = false;
+      }
     }
-    a.segment_constraint = s;
+    s.animators.push_back(an);
   }
+  std::sort(s.animators.begin(), s.animators.end(),
+            [](const auto& x, const auto& y) { return x.animator < y.animator; });
+  const std::size_t k = s.animators_with_short_segments;
+  s.mean_increase_percent = k ? sum / k : 0.0;
+  if (paper_scale) {
+    s.max_paper_scale_percent = paper_max;
+    s.mean_paper_scale_percent = k ? paper_sum / k : 0.0;
+    s.max_increase_per_frame = per_frame_max;
+    s.all_below_threshold = paper_below;
+    s.threshold_scale = "paper";
+  } else {
+    s.all_below_threshold = relative_below;
+  }
+  return s;
+}
+
+}  // namespace
+
+StudyAnalysis AnalyzeStudy(const StudyData& data, const StudyAnalysisOptions& options) {
+  options.Validate("stats");
+  ValidateStudyData(data, options.data);
+  StudyAnalysis a;
+  a.options = options;
+  AnalyzeRankings(data, a);
+  ScoreTakes(data, a);
+  AnalyzeH1(options, a);
+  AnalyzeH2(options, a);
+  AnalyzeH3(data, options, a);
+  if (!data.segment_costs.empty()) a.segment_constraint = AnalyzeSegmentConstraint(data, options);
   return a;
 }
 

@@ -189,7 +189,7 @@ void WriteStudyFolder(const std::filesystem::path& out_dir, const StudyConfig& c
         "the full-fidelity study of " +
         (options.config_file.empty() ? std::string("the defaults") : options.config_file) + " (" +
         std::to_string(s.animators.size()) + " animators, population seed " +
-        std::to_string(config.run.render.population.seed) + ") at commit " + options.git_commit +
+        std::to_string(config.run.people.population.seed) + ") at commit " + options.git_commit +
         ".";
     WriteFileAtomically(out / "error_model.inc", s.measured_error_model->DefaultsSource(origin));
   }

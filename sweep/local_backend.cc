@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "core/atomic_file.h"
+#include "core/duration_text.h"
 #include "core/error.h"
 #include "sweep/cell_store.h"
 #include "sweep/worker.h"
@@ -55,18 +56,6 @@ pid_t SpawnWorker(const std::string& executable, const fs::path& dir, const std:
   }
   close(log_fd);
   return pid;
-}
-
-std::string Eta(double seconds) {
-  char text[32];
-  if (seconds < 90) {
-    std::snprintf(text, sizeof(text), "%.0f s", seconds);
-  } else if (seconds < 5400) {
-    std::snprintf(text, sizeof(text), "%.0f min", seconds / 60);
-  } else {
-    std::snprintf(text, sizeof(text), "%.1f h", seconds / 3600);
-  }
-  return text;
 }
 
 }  // namespace
@@ -114,7 +103,7 @@ LocalSummary RunLocal(const Plan& plan, const fs::path& dir, const LocalOptions&
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const int finished = summary.done + summary.failed;
     const std::string eta =
-        finished > 0 ? Eta(elapsed / finished * (to_run - finished)) : std::string("?");
+        finished > 0 ? FormatDuration(elapsed / finished * (to_run - finished)) : std::string("?");
     std::fprintf(stderr, "\rsweep: %d / %d cells done, %d failed, %d skipped, ETA %s   ",
                  summary.done, to_run, summary.failed, summary.skipped, eta.c_str());
     std::fflush(stderr);

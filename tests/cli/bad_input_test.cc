@@ -577,10 +577,10 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
        "render --set sensor.frame_rate=NaN --out {OUT}",
        {"sensor.frame_rate", "NaN"}},
       {"render: story missing",
-       "render --set render.story=/nonexistent/story.json --out {OUT}",
+       "render --set scenario.story=/nonexistent/story.json --out {OUT}",
        {"/nonexistent/story.json"}},
       {"render: story with a repeated key",
-       "render --set render.story={D}/s.json --out {OUT}",
+       "render --set scenario.story={D}/s.json --out {OUT}",
        {"s.json: key 'objects[0].name'", "appears twice"},
        {{"s.json", R"({"name": "x", "objects": [{"name": "a", "name": "b"}]})"}}},
 

@@ -87,8 +87,8 @@ TEST_F(RenderCliTest, RendersAParticipantsTakeAndItsAnnotationSession) {
   const std::string study = std::string(MMH_SOURCE_DIR) + "/configs/study_soldier.json";
   const std::string story = std::string(MMH_SOURCE_DIR) + "/configs/stories/soldier.json";
   const std::string args =
-      " --config " + study + " --set render.story=\\\"" + story +
-      "\\\" --set render.animator=2 --set render.take=1 --set render.frames=3 --quiet";
+      " --config " + study + " --set scenario.story=\\\"" + story +
+      "\\\" --set scenario.animator=2 --set render.take=1 --set render.frames=3 --quiet";
   auto r = RunMmh("render --out " + (dir_ / "rec").string() + args);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = RunMmh("render --out " + (dir_ / "ann").string() + args + " --set render.session=annotation");
@@ -121,7 +121,7 @@ TEST_F(RenderCliTest, RendersAParticipantsTakeAndItsAnnotationSession) {
       dir_ / "bad.json",
       R"({"name": "b", "objects": [{"name": "a", "path": [[0, 0], [0.1, 0]], "end": 5,
                            "beats": [{"kind": "walk", "start": 0, "to": 1}, {"kind": "skip", "start": 2}]}]})");
-  r = RunMmh("render --out " + (dir_ / "bad").string() + " --set render.story=\\\"" +
+  r = RunMmh("render --out " + (dir_ / "bad").string() + " --set scenario.story=\\\"" +
              (dir_ / "bad.json").string() + "\\\" --quiet");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("bad.json: objects[0].beats[1].kind"));

@@ -16,7 +16,7 @@ using test_util::TempDir;
 using test_util::WriteText;
 
 const std::string kSource = MMH_SOURCE_DIR;
-const std::string kStory = "--set 'render.story=\"" + kSource + "/configs/stories/soldier.json\"' ";
+const std::string kStory = "--set 'scenario.story=\"" + kSource + "/configs/stories/soldier.json\"' ";
 
 // Two 70-frame takes of the Soldier, rendered, tracked, read and composited.
 std::string ShortRun(const std::filesystem::path& out, const std::string& extra = "") {
@@ -50,7 +50,7 @@ TEST(RunCliTest, WritesEveryResultAndTheSameBytesForAnyThreadCount) {
 TEST(RunCliTest, BadInputExitsTwoAndWritesNothing) {
   TempDir dir;
   auto r = RunMmh("run --config " + kSource +
-                  "/configs/soldier.json --set 'render.story=\"nowhere/story.json\"' --out " +
+                  "/configs/soldier.json --set 'scenario.story=\"nowhere/story.json\"' --out " +
                   (dir / "a").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("nowhere/story.json"), std::string::npos) << r.output;
@@ -114,7 +114,7 @@ TEST(RunCliTest, RegressPassesItsOwnBaselineAndCatchesAChange) {
   WriteText(dir / "baseline/baseline.json",
             R"({"root": ")" + kSource + R"(", "scenarios": [{"name": "quick",
                "config": "configs/soldier.json", "set": ["run.fidelity=fast", "render.frames=300",
-               "render.story=\"configs/stories/soldier.json\""], "metrics": {}}]})");
+               "scenario.story=\"configs/stories/soldier.json\""], "metrics": {}}]})");
   auto r = RunMmh("regress --baseline " + (dir / "baseline").string() + " --update --quiet --out " +
                   (dir / "update").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;

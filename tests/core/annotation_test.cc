@@ -23,16 +23,9 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
 using test_util::ReadBytes;
+using test_util::ListDir;
 using test_util::TempDir;
 using test_util::WriteText;
-
-std::vector<std::string> ListDir(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir))
-    names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 std::string ReadCsvError(const fs::path& path) {
   try {

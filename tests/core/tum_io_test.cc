@@ -26,18 +26,10 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-// A fresh folder under the system temp dir, removed at the end of the test.
 using test_util::ReadBytes;
+using test_util::ListDir;
 using test_util::TempDir;
 using test_util::WriteText;
-
-std::vector<std::string> ListDir(const fs::path& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir))
-    names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 // Runs ReadTum expecting an InputError; returns its message.
 std::string ReadTumError(const fs::path& path) {

@@ -19,7 +19,7 @@ using test_util::ErrorOf;
 // A short Soldier scenario: `frames` frames of `takes` takes (the beginning of each take).
 RunConfig ShortConfig(Fidelity fidelity, int frames, int takes = 2) {
   Config config;
-  config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  config.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   config.Set("scene.props=castle");
   config.Set("render.frames=" + std::to_string(frames));
   config.Set("run.takes=" + std::to_string(takes));
@@ -44,8 +44,8 @@ TEST(FillGapsTest, InterpolatesBetweenEstimatesAndHoldsAtTheEnds) {
 
 TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
   const RunConfig config = ShortConfig(Fidelity::kFast, 0, 3);
-  const AnimatorRun a = RunAnimator(config, 2);
-  const AnimatorRun b = RunAnimator(config, 2);
+  const AnimatorRun a = RunAnimator(config.ForAnimator(2));
+  const AnimatorRun b = RunAnimator(config.ForAnimator(2));
   EXPECT_EQ(ToJson(*a.metrics).dump(), ToJson(*b.metrics).dump());
   ASSERT_EQ(a.takes.size(), 3u);
   EXPECT_EQ(a.rendered_frames, 0);
@@ -58,17 +58,17 @@ TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
   // Tracker-sized errors barely change the montage.
   EXPECT_GT(a.metrics->tracked_vs_truth.label_agreement, 0.8);
   // The other animator's run differs.
-  EXPECT_NE(ToJson(*RunAnimator(config, 3).metrics).dump(), ToJson(*a.metrics).dump());
+  EXPECT_NE(ToJson(*RunAnimator(config.ForAnimator(3)).metrics).dump(), ToJson(*a.metrics).dump());
 }
 
 // The paper's protocol starts with a Mario practice: recorded and tracked, not composited; the
 // takes' skill index starts after it.
 TEST(AnimatorRunTest, APracticeTakeComesFirstAndIsNotComposited) {
   Config config;
-  config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  config.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   config.Set(std::string("run.practice=\"") + MMH_SOURCE_DIR + "/configs/stories/mario.json\"");
   config.Set("run.fidelity=fast");
-  const AnimatorRun run = RunAnimator(RunConfig::FromConfig(config), 4);
+  const AnimatorRun run = RunAnimator(RunConfig::FromConfig(config).ForAnimator(4));
   ASSERT_TRUE(run.practice.has_value());
   EXPECT_EQ(run.practice->take, 0);
   EXPECT_TRUE(run.practice->read_annotation.values.empty());
@@ -86,8 +86,9 @@ TEST(AnimatorRunTest, APracticeTakeComesFirstAndIsNotComposited) {
 TEST(AnimatorRunTest, FullFidelityTracksReadsAndDoesNotDependOnThreads) {
   const RunConfig config = ShortConfig(Fidelity::kFull, 75);
   std::vector<std::pair<int, int>> done;
-  const AnimatorRun run = RunAnimator(
-      config, 1, {}, [&](const TakeRun& t, bool practice) { done.emplace_back(t.take, practice); });
+  const AnimatorRun run = RunAnimator(config.ForAnimator(1), {}, [&](const TakeRun& t, bool practice) {
+    done.emplace_back(t.take, practice);
+  });
   EXPECT_EQ(done, (std::vector<std::pair<int, int>>{{0, 0}, {1, 0}}));
   EXPECT_EQ(run.rendered_frames, 2 * 2 * 75);
   for (const TakeMetrics& t : run.metrics->takes) {
@@ -101,13 +102,13 @@ TEST(AnimatorRunTest, FullFidelityTracksReadsAndDoesNotDependOnThreads) {
   EXPECT_EQ(run.montage.summary.reference_frames, 75);
   {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    EXPECT_EQ(ToJson(*RunAnimator(config, 1).metrics).dump(), ToJson(*run.metrics).dump());
+    EXPECT_EQ(ToJson(*RunAnimator(config.ForAnimator(1)).metrics).dump(), ToJson(*run.metrics).dump());
   }
 }
 
 TEST(AnimatorRunTest, ATakeWhoseTrackingFailedIsNamedAndTheFinishedTakesAreReported) {
   Config config;
-  config.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  config.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   config.Set("render.frames=20");
   // Short takes must still be longer than the montage's shortest segment (checked up front).
   config.Set("montage.labelling.min_segment_length=10");
@@ -117,7 +118,7 @@ TEST(AnimatorRunTest, ATakeWhoseTrackingFailedIsNamedAndTheFinishedTakesAreRepor
   const RunConfig run_config = RunConfig::FromConfig(config);
   int reported = 0;
   try {
-    RunAnimator(run_config, 0, {}, [&](const TakeRun&, bool) { ++reported; });
+    RunAnimator(run_config, {}, [&](const TakeRun&, bool) { ++reported; });
     FAIL() << "no RunError";
   } catch (const RunError& e) {
     EXPECT_NE(std::string(e.what()).find("take 0: tracking failed"), std::string::npos) << e.what();
@@ -128,29 +129,29 @@ TEST(AnimatorRunTest, ATakeWhoseTrackingFailedIsNamedAndTheFinishedTakesAreRepor
 
 TEST(AnimatorRunTest, BadInputIsNamed) {
   Config config;
-  config.Set("render.story=\"no/such/story.json\"");
+  config.Set("scenario.story=\"no/such/story.json\"");
   EXPECT_NE(
-      ErrorOf([&] { RunAnimator(RunConfig::FromConfig(config), 0); }).find("no/such/story.json"),
+      ErrorOf([&] { RunAnimator(RunConfig::FromConfig(config)); }).find("no/such/story.json"),
       std::string::npos);
   Config no_story;
-  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(no_story); }).find("render.story"),
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(no_story); }).find("scenario.story"),
             std::string::npos);
   Config one_take;
-  one_take.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  one_take.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   one_take.Set("run.takes=1");
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(one_take); }).find("run.takes"), std::string::npos);
   Config unknown;
-  unknown.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  unknown.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   unknown.Set("run.take=2");
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(unknown); }).find("run.take"), std::string::npos);
   Config section;
-  section.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  section.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   section.Set("tracking.x=2");
   EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(section); }).find("tracking"), std::string::npos);
   Config object;
-  object.Set(std::string("render.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
-  object.Set("render.object=1");
-  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(object); }).find("render.object"),
+  object.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
+  object.Set("scenario.object=1");
+  EXPECT_NE(ErrorOf([&] { RunConfig::FromConfig(object); }).find("scenario.object"),
             std::string::npos);
 }
 

@@ -278,7 +278,7 @@ TEST(ReportCli, ComposeFolderInTheBrowser) {
 TEST(ReportCli, RunFolderInTheBrowser) {
   TempDir dir;
   const auto out = dir / "run";
-  auto r = RunMmh("run --config " + kSource + "/configs/soldier.json --set 'render.story=\"" +
+  auto r = RunMmh("run --config " + kSource + "/configs/soldier.json --set 'scenario.story=\"" +
                   kSource + "/configs/stories/soldier.json\"' --set render.frames=70 --set " +
                   "run.takes=2 --quiet --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -434,7 +434,7 @@ TEST(ReportCli, SweepFolderInTheBrowser) {
 TEST(ReportCli, StudyFolderInTheBrowser) {
   TempDir dir;
   const auto out = dir / "study";
-  auto r = RunMmh("study --config " + kSource + "/configs/study_soldier.json --set render.story=" +
+  auto r = RunMmh("study --config " + kSource + "/configs/study_soldier.json --set scenario.story=" +
                   kSource + "/configs/stories/soldier.json --set run.practice=" + kSource +
                   "/configs/stories/mario.json --set run.fidelity=fast --set study.animators=4 " +
                   "--set render.frames=600 --quiet --out " + out.string());

@@ -21,7 +21,7 @@ const std::string kSource = MMH_SOURCE_DIR;
 
 Config SmallConfig(int animators, const std::string& fidelity = "fast") {
   Config config = Config::Load(kSource + "/configs/study_soldier.json");
-  config.Set("render.story=" + kSource + "/configs/stories/soldier.json");
+  config.Set("scenario.story=" + kSource + "/configs/stories/soldier.json");
   config.Set("run.practice=" + kSource + "/configs/stories/mario.json");
   config.Set("run.fidelity=" + fidelity);
   config.Set("study.animators=" + std::to_string(animators));
@@ -118,8 +118,8 @@ TEST(SimulatedStudyTest, ReplicatesAreIndependentSamples) {
   const StudyConfig r1 = config.ForReplicate(1);
   const StudyConfig r2 = config.ForReplicate(2);
   EXPECT_EQ(r0.ToJson(), config.ToJson());
-  std::set<std::uint64_t> seeds = {r0.run.render.population.seed, r1.run.render.population.seed,
-                                   r2.run.render.population.seed};
+  std::set<std::uint64_t> seeds = {r0.run.people.population.seed, r1.run.people.population.seed,
+                                   r2.run.people.population.seed};
   EXPECT_EQ(seeds.size(), 3u);
   EXPECT_NE(r1.study.seed, r0.study.seed);
   const SimulatedStudy s1 = RunSimulatedStudy(r1, 1);
@@ -210,8 +210,8 @@ TEST(SimulatedStudyTest, FastFidelityAgreesWithFullFidelity) {
   const StudyConfig full_config = StudyConfig::FromConfig(config);
   config.Set("run.fidelity=fast");
   const StudyConfig fast_config = StudyConfig::FromConfig(config);
-  const pipeline::AnimatorRun full = pipeline::RunAnimator(full_config.run, 1);
-  const pipeline::AnimatorRun fast = pipeline::RunAnimator(fast_config.run, 1);
+  const pipeline::AnimatorRun full = pipeline::RunAnimator(full_config.run.ForAnimator(1));
+  const pipeline::AnimatorRun fast = pipeline::RunAnimator(fast_config.run.ForAnimator(1));
   EXPECT_EQ(full.rendered_frames, 3 * 2 * 90);
   EXPECT_EQ(fast.rendered_frames, 0);
 

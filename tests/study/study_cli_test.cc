@@ -17,7 +17,7 @@ using test_util::TempDir;
 const std::string kSource = MMH_SOURCE_DIR;
 
 std::string SmallStudy(const std::string& extra = "") {
-  return "study --config " + kSource + "/configs/study_soldier.json --set render.story=" + kSource +
+  return "study --config " + kSource + "/configs/study_soldier.json --set scenario.story=" + kSource +
          "/configs/stories/soldier.json --set run.practice=" + kSource +
          "/configs/stories/mario.json --set run.fidelity=fast --set study.animators=4 --set "
          "render.frames=600 --quiet " +
@@ -32,7 +32,7 @@ TEST(StudyCliTest, FullFidelityWritesTheErrorModelFit) {
   TempDir dir;
   const auto out = dir / "study";
   const auto run = RunMmh("study --config " + kSource + "/configs/study_soldier.json --set " +
-                          "render.story=" + kSource + "/configs/stories/soldier.json --set " +
+                          "scenario.story=" + kSource + "/configs/stories/soldier.json --set " +
                           "run.practice=" + kSource + "/configs/stories/mario.json --set " +
                           "study.animators=3 --set render.frames=61 --quiet --out " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;

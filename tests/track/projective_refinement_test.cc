@@ -43,7 +43,7 @@ struct SoldierFrames {
 SoldierFrames RenderSoldierFrames(int first, int count, const std::string& sensor) {
   const test_util::TempDir dir;
   const std::filesystem::path config = dir.path() / "story.json";
-  test_util::WriteText(config, R"({"render": {"story": "configs/stories/soldier.json"},
+  test_util::WriteText(config, R"({"scenario": {"story": "configs/stories/soldier.json"},
                                    "scene": {"props": "castle"}, "sensor": {)" +
                                    sensor + "}}");
   int take_frames = 0;

@@ -99,7 +99,7 @@ TEST(ProxyModelTest, ANoiseFreeFrameIsFittedAtTheTruth) {
   const test_util::TempDir dir;
   const std::filesystem::path config = dir.path() / "noise_free.json";
   test_util::WriteText(config,
-                       R"({"render": {"story": "configs/stories/soldier.json"},
+                       R"({"scenario": {"story": "configs/stories/soldier.json"},
                            "population": {"learning_mean": 0.3},
                            "scene": {"props": "castle"},
                            "sensor": {"noise": false, "quantise": false}})");

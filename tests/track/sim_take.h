@@ -73,7 +73,7 @@ class SimTake {
 };
 
 // A session of the Soldier story (configs/study_soldier.json: the castle props, the study's
-// population) as `mmh render --config configs/study_soldier.json --set render.animator=A
+// population) as `mmh render --config configs/study_soldier.json --set scenario.animator=A
 // --set render.take=K --set render.session=...` renders it: participant `animator` performs take
 // `take` of the Soldier (people::PerformTake); a recording session moves the proxy along the performed
 // take with the hand on it, an annotation session rests the proxy beside the play area and moves
@@ -83,13 +83,14 @@ class SimTake {
 inline SimTake SoldierStorySession(const std::string& source, int animator, int take,
                                    sim::RenderSession session, int* frames,
                                    const std::string& config_file = "configs/study_soldier.json") {
-  sim::RenderConfig config =
-      sim::RenderConfig::FromConfig(Config::Load(source + "/" + config_file));
-  config.render.story = source + "/" + config.render.story;
-  config.render.animator = animator;
+  const Config file = Config::Load(source + "/" + config_file);
+  sim::RenderConfig config = sim::RenderConfig::FromConfig(file);
+  people::PeopleConfig people = people::PeopleConfig::FromConfig(file);
+  people.scenario.story = source + "/" + people.scenario.story;
+  people.scenario.animator = animator;
   config.render.take = take;
   config.render.session = session;
-  const sim::StoryScript script(config, config.render.story, 0, animator);
+  const sim::StoryScript script(people, config.scene);
   auto performed = std::make_shared<const people::PerformedTake>(script.Perform(take));
   config.render.proxy = script.ProxyFile();
   *frames = performed->frames();
@@ -99,7 +100,7 @@ inline SimTake SoldierStorySession(const std::string& source, int animator, int 
     return std::clamp(static_cast<int>(std::lround(t * rate)), 0, last);
   };
   if (session == sim::RenderSession::kRecording) {
-    const double rest = config.annotator.start_value;
+    const double rest = people.annotator.start_value;
     return SimTake(
         config,
         [performed, frame_at](double t) { return performed->table_T_proxy.poses[frame_at(t)]; },

@@ -110,8 +110,8 @@ TEST(TrackCliTest, SliderOnlyModeOnAnAnnotationSession) {
   const fs::path take = dir / "annotation";
   const std::string source = MMH_SOURCE_DIR;
   auto render = RunMmh("render --quiet --config " + source +
-                       "/configs/study_soldier.json --set render.story=\\\"" + source +
-                       "/configs/stories/soldier.json\\\" --set render.animator=3 --set "
+                       "/configs/study_soldier.json --set scenario.story=\\\"" + source +
+                       "/configs/stories/soldier.json\\\" --set scenario.animator=3 --set "
                        "render.take=1 --set render.session=annotation --set render.frames=30 "
                        "--out " +
                        take.string());

@@ -1,0 +1,51 @@
+// `mmh sensor-check`: real Kinect v1 depth frames (TUM, NYU; SUN's sensor differs and is shown for
+// contrast) beside frames the sensor model renders of the table-top scene in both of its modes,
+// the statistical model and structured light (docs/sensor.md). The statistics are
+// sim/sensor_check.h's and sim/error_structure.h's; this file runs them over both kinds of frame.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "sim/error_structure.h"
+#include "sim/render_session.h"
+#include "sim/sensor_check.h"
+
+namespace mmh::sim {
+
+struct SensorCheckReport {
+  // TUM real, NYU real, SUN real, then the first frame of each rendered mode.
+  std::vector<SensorStatistics> columns;
+  // Every rendered frame: the statistical mode's, then structured light's.
+  std::vector<SensorStatistics> rendered_frames;
+  // The error structure of TUM, NYU and each mode's first frame, by name.
+  std::vector<std::string> structure_names;
+  std::vector<ErrorStructure> structures;
+  // Structured light's first frame: missing pixels by the sensor's cause against the causes the
+  // depth-image rules name.
+  std::string cause_table;
+  // Depth [m] of the TUM frame and of each mode's first frame (statistical, structured light),
+  // width x height row-major, for the side-by-side picture.
+  int width = 0, height = 0;
+  std::vector<float> tum_depth_m;
+  std::vector<float> rendered_depth_m[2];
+
+  // The tables `mmh sensor-check` prints.
+  std::string Format() const;
+  // sensor_check.json: columns, rendered_frames, error_structure.
+  nlohmann::json ToJson() const;
+};
+
+// Reads TUM_depth.png, NYU_depth.pgm and SUN_depth.png from `real_frames` (InputError naming a
+// missing or unreadable file) and renders `frames` frames of `config`'s scene (the demo walk) in
+// both sensor modes.
+SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
+                                 const RenderConfig& config, int frames);
+
+// Writes sensor_check.json and, when the frames have the same size, sensor_check.png (TUM,
+// statistical, structured light side by side) into `out`.
+void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out);
+
+}  // namespace mmh::sim
