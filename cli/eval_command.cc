@@ -17,6 +17,7 @@
 #include "core/mesh_io.h"
 #include "core/rgbd_folder.h"
 #include "core/tum_io.h"
+#include "metrics/model_symmetries.h"
 #include "metrics/pose_evaluation.h"
 #include "track/recording.h"
 #include "track/track_section.h"
@@ -30,7 +31,35 @@ struct EvalArgs {
   std::string estimate;
   std::string truth;
   std::string model;
+  std::string models_info;
 };
+
+// The object's symmetry transformations from BOP's models_info.json: --models-info, or the
+// models_info.json beside the model when there is one (none: the identity only). The file's
+// translations are in the model's units (model_scale). Records the file used in *used.
+std::vector<Rigid3> ObjectSymmetries(const EvalArgs& args, int object, double model_scale,
+                                     double max_step, std::string* used) {
+  namespace fs = std::filesystem;
+  fs::path path = args.models_info;
+  const bool given = !path.empty();
+  if (!given) {
+    path = fs::path(args.model).parent_path() / "models_info.json";
+    if (!fs::exists(path)) return {};
+  }
+  const auto objects = metrics::ReadModelsInfo(path, model_scale);
+  const auto it = objects.find(object);
+  if (it == objects.end()) {
+    if (given) {
+      throw InputError(path.string() + ": no entry for object " + std::to_string(object) +
+                       " (track.object)");
+    }
+    return {};
+  }
+  *used = path.string();
+  std::vector<Rigid3> all = metrics::SymmetryTransformations(it->second, max_step);
+  all.erase(all.begin());  // the identity (EvaluateObject implies it)
+  return all;
+}
 
 // Section "track" (the keys it shares with mmh track's, and the time tolerance).
 struct EvalRunOptions {
@@ -116,6 +145,7 @@ void RunEval(const EvalArgs& args, const std::vector<std::string>& argv) {
         e.camera_T_truth = t.camera_T_object;
         e.camera_T_estimate = EstimateAt(estimates, frame.timestamp, run.time_tolerance);
         e.intrinsics = info.intrinsics;
+        e.visible_fraction = t.visible_fraction;
         if (options.vsd && !frame.depth.empty()) {
           e.test_distance = metrics::DepthToDistance(frame.depth, frame.depth_scale, info.intrinsics);
         }
@@ -152,14 +182,20 @@ void RunEval(const EvalArgs& args, const std::vector<std::string>& argv) {
     throw InputError(description + ": no frame with ground truth of object " +
                      std::to_string(object));
   }
+  std::string models_info;
+  const std::vector<Rigid3> symmetries =
+      ObjectSymmetries(args, object, run.model_scale, options.max_symmetry_step, &models_info);
   std::vector<metrics::ObjectEvaluation> objects;
-  objects.push_back(metrics::EvaluateObject(object, std::move(frames), model, {}, options));
+  objects.push_back(metrics::EvaluateObject(object, std::move(frames), model, symmetries, options));
 
   const fs::path out = args.common.out_dir;
   EnsureDirectory(out);
   WriteFileAtomically(out / "eval_frames.csv", metrics::FramesCsv(objects));
   WriteFileAtomically(out / "eval_objects.csv", metrics::ObjectsCsv(objects));
-  nlohmann::json result = {{"input", description}, {"estimate", args.estimate}, {"objects", {}}};
+  nlohmann::json result = {{"input", description},
+                           {"estimate", args.estimate},
+                           {"models_info", models_info.empty() ? nlohmann::json() : nlohmann::json(models_info)},
+                           {"objects", {}}};
   for (const auto& o : objects) result["objects"].push_back(metrics::ToJson(o));
   WriteFileAtomically(out / "eval.json", result.dump(2) + "\n");
   const nlohmann::json resolved = {{"track", ToJson(run)}, {"eval", ToJson(options)}};
@@ -201,6 +237,9 @@ void AddEvalCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->add_option("--model", args->model, "The object's mesh (.ply or .obj)")->required();
   cmd->add_option("--truth", args->truth,
                   "Ground truth (TUM) for a TUM folder; default: its groundtruth.txt");
+  cmd->add_option("--models-info", args->models_info,
+                  "BOP models_info.json with the object's symmetries (units of the model file); "
+                  "default: models_info.json beside --model when there is one");
   cmd->add_option("--config", args->common.config_file, "JSON config: sections track, eval");
   cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
       ->take_all();

@@ -14,6 +14,8 @@ void PoseEvaluationOptions::Validate(const std::string& prefix) const {
   if (surface_points < 0) {
     ThrowBadValue(prefix + ".surface_points", std::to_string(surface_points), ">= 0");
   }
+  RequireProbability(min_visible_fraction, prefix + ".min_visible_fraction");
+  RequirePositive(max_symmetry_step, prefix + ".max_symmetry_step");
   bop.Validate(prefix + ".bop");
 }
 
@@ -23,6 +25,12 @@ ObjectEvaluation EvaluateObject(int object, std::vector<EvaluationFrame> frames,
   options.Validate("eval");
   ObjectEvaluation evaluation;
   evaluation.object = object;
+  evaluation.symmetries = static_cast<int>(symmetries.size());
+  const size_t all_frames = frames.size();
+  std::erase_if(frames, [&](const EvaluationFrame& f) {
+    return f.visible_fraction >= 0 && f.visible_fraction < options.min_visible_fraction;
+  });
+  evaluation.low_visibility = static_cast<int>(all_frames - frames.size());
   const ModelPoints points = ErrorPoints(model, options.surface_points);
   evaluation.points = static_cast<int>(points.rows());
   evaluation.diameter = Diameter(points);
@@ -42,8 +50,11 @@ ObjectEvaluation EvaluateObject(int object, std::vector<EvaluationFrame> frames,
     BopFrameErrors e;
     e.has_estimate = f.camera_T_estimate.has_value();
     if (e.has_estimate) {
-      e.rotation_deg = basic[i].rotation_deg;
-      e.translation = basic[i].translation;
+      const Rigid3 truth =
+          NearestSymmetricTruth(*f.camera_T_estimate, f.camera_T_truth, points, symmetries);
+      e.rotation_deg =
+          RotationAngle(f.camera_T_estimate->rotation, truth.rotation) * 180 / std::numbers::pi;
+      e.translation = (f.camera_T_estimate->translation - truth.translation).norm();
       e.add = basic[i].add;
       e.adds = basic[i].adds;
       e.mssd = Mssd(*f.camera_T_estimate, f.camera_T_truth, points, symmetries);
@@ -111,6 +122,8 @@ nlohmann::json ToJson(const ObjectEvaluation& evaluation) {
   j["object"] = evaluation.object;
   j["diameter_mm"] = evaluation.diameter * 1000;
   j["error_points"] = evaluation.points;
+  j["symmetries"] = evaluation.symmetries;
+  j["low_visibility_frames_left_out"] = evaluation.low_visibility;
   return j;
 }
 

@@ -50,6 +50,10 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(seed_turn_deg, prefix + ".seed_turn_deg", "deg");
   RequireNonNegative(slide_drop, prefix + ".slide_drop");
   RequireNonNegative(rival_threshold, prefix + ".rival_threshold");
+  if (model_segments < 0) {
+    ThrowBadValue(prefix + ".model_segments", std::to_string(model_segments), ">= 0 (0: off)");
+  }
+  RequireNonNegative(segment_slack, prefix + ".segment_slack", "m");
   if (trusted_frames < 0) {
     ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
   }
@@ -487,6 +491,54 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   return best;
 }
 
+std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAmongSegments(
+    const RgbdFrame& frame, const std::optional<Rigid3>& predicted) {
+  const DetectionOptions& o = options_.detection;
+  const Segmentation whole = segmentation_;
+  // A segment's points: at most the model's diameter apart (its bounding box's diagonal, plus
+  // the slack for depth noise and flying pixels at its edges).
+  const double max_extent = 2 * model_->radius() + o.segment_slack;
+  std::optional<Candidate> best;
+  double best_rank = 0.0;
+  std::optional<Segmentation> best_segment;
+  std::optional<Rigid3> best_rival;
+  int tried = 0;
+  for (size_t c = 0; c < whole.component_sizes.size() && tried < o.model_segments; ++c) {
+    Segmentation segment;
+    for (size_t i = 0; i < whole.points.size(); ++i) {
+      if (whole.components[i] != static_cast<int>(c)) continue;
+      segment.points.push_back(whole.points[i]);
+      segment.components.push_back(0);
+    }
+    if (static_cast<int>(segment.points.size()) < options_.verification.min_points) break;
+    Eigen::AlignedBox3f box;
+    for (const auto& p : segment.points) box.extend(p);
+    if (box.diagonal().norm() > max_extent) continue;
+    ++tried;
+    segment.component_sizes = {whole.component_sizes[c]};
+    segmentation_ = segment;
+    PrepareData();
+    std::optional<Candidate> candidate = Detect(frame, predicted, false);
+    if (!candidate) continue;
+    // The inlier share is of this segment's points, which a pose on a small part of another
+    // object also explains: the share of the model's visible surface that the depth confirms
+    // tells the object that fills the model.
+    const double rank = candidate->Score() + candidate->explained;
+    const bool better = !best || (candidate->good && !best->good) ||
+                        (candidate->good == best->good && rank > best_rank);
+    if (better) {
+      best = candidate;
+      best_rank = rank;
+      best_segment = segment;
+      best_rival = detection_rival_;
+    }
+  }
+  detection_rival_ = best_rival;
+  segmentation_ = best_segment ? *best_segment : whole;
+  PrepareData();
+  return best;
+}
+
 ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
                                                 const Rigid3& camera_T_proxy) const {
   PoseScore score;
@@ -752,7 +804,9 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   if (!chosen) segment_whole_play_area();
   enough = result.points >= options_.verification.min_points;
   if (!chosen && enough) {
-    std::optional<Candidate> detected = Detect(frame, predicted, false);
+    std::optional<Candidate> detected = options_.detection.model_segments > 0
+                                            ? DetectAmongSegments(frame, predicted)
+                                            : Detect(frame, predicted, false);
     frames_since_detection_ = 0;
     if (detected && detected->good) {
       chosen = detected;

@@ -105,6 +105,13 @@ struct DetectionOptions {
   double slide_drop = 0.02;
   double rival_drift = 0.03;
   double rival_threshold = 0.25;
+  // Real recordings (the object among others on a table): a detection after a loss tries up to
+  // model_segments segments, largest first, each no larger than the model's bounding sphere
+  // (diameter plus segment_slack [m]), on that segment's points alone, and keeps the verified
+  // pose that scores best with the share of the model's visible surface the depth confirms
+  // (0: the proxy's rule, the largest segment of the play volume is the proxy).
+  int model_segments = 0;
+  double segment_slack = 0.02;
 
   template <class V>
   void VisitFields(V& v) {
@@ -131,6 +138,8 @@ struct DetectionOptions {
     v("slide_drop", slide_drop);
     v("rival_drift", rival_drift);
     v("rival_threshold", rival_threshold);
+    v("model_segments", model_segments);
+    v("segment_slack", segment_slack);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -301,6 +310,10 @@ class ProxyTracker {
   // `light`: only the motion model's seeds and the twins, no coarse hypotheses.
   std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted,
                                   bool light);
+  // The detection among the model-sized segments (DetectionOptions::model_segments); leaves
+  // segmentation_ and data_ holding the winner's segment.
+  std::optional<Candidate> DetectAmongSegments(const RgbdFrame& frame,
+                                               const std::optional<Rigid3>& predicted);
   // The coarse hypotheses' alignments (orientations about the table normal, placed at the largest
   // segment); *scored: how many of their points are scored. Empty without a large enough segment.
   std::vector<IcpResult> CoarseHypotheses(const IcpOptions& coarse_icp, size_t* scored) const;
