@@ -77,6 +77,14 @@ ObjectEvaluation EvaluateObject(int object, std::vector<EvaluationFrame> frames,
 // recall_2deg_2cm,median_rotation_deg,median_translation_mm, one row per object.
 std::string FramesCsv(const std::vector<ObjectEvaluation>& objects);
 std::string ObjectsCsv(const std::vector<ObjectEvaluation>& objects);
+
+// The objects' instances pooled, as BOP's dataset score pools them: every recall and AR the
+// frame-weighted mean of the objects' (a recall is correct instances over instances, so the
+// weighted mean is the pooled count), the medians over every frame with an estimate.
+BopRecall PooledRecall(const std::vector<ObjectEvaluation>& objects);
+// One row: objects,frames,ar,ar_vsd,ar_mssd,ar_mspd,add_recall,adds_recall,recall_5deg_5cm,
+// recall_2deg_2cm,median_rotation_deg,median_translation_mm.
+std::string OverallCsv(const std::vector<ObjectEvaluation>& objects);
 nlohmann::json ToJson(const ObjectEvaluation& evaluation);
 
 }  // namespace mmh::metrics

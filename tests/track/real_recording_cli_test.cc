@@ -85,6 +85,25 @@ TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
   EXPECT_LT(brick.median_translation_mm, 5.0);
   EXPECT_GE(brick.recall_5deg_5cm, 0.9);
   EXPECT_GE(brick.ar, 0.9);
+
+  // Both objects in one call from the runs' BOP result files: the same per-object figures (R to
+  // 9 digits), and the pooled row weighs them by frames.
+  std::string both = ReadBytes(dir / "track_detection8" / "results_bop.csv");
+  const std::string brick_results = ReadBytes(dir / "track_detection21" / "results_bop.csv");
+  both += brick_results.substr(brick_results.find('\n') + 1);
+  WriteText(dir / "both.csv", both);
+  const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model 8=" +
+                             (kReal / "models" / "009_gelatin_box.obj").string() + " --model 21=" +
+                             (kReal / "models" / "061_foam_brick.obj").string() + " --estimate " +
+                             (dir / "both.csv").string() + " --out " + (dir / "both").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto json = nlohmann::json::parse(ReadBytes(dir / "both" / "eval.json"));
+  ASSERT_EQ(json["objects"].size(), 2u);
+  EXPECT_NEAR(json["objects"][0]["median_rotation_deg"].get<double>(), box.median_rotation_deg, 1e-4);
+  EXPECT_NEAR(json["objects"][1]["ar"].get<double>(), brick.ar, 1e-9);
+  EXPECT_EQ(json["overall"]["frames"], 20);
+  EXPECT_NEAR(json["overall"]["ar"].get<double>(), (box.ar + brick.ar) / 2, 1e-9);
+  EXPECT_TRUE(fs::exists(dir / "both" / "eval_overall.csv"));
 }
 
 TEST(RealRecordingCliTest, EvalOfTheTruthItselfIsPerfect) {
