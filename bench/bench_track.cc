@@ -157,11 +157,13 @@ void BM_PclIcpWithNormals(benchmark::State& state) {
 BENCHMARK(BM_PclIcpWithNormals)->Unit(benchmark::kMillisecond);
 
 // Real frames: the committed YCB-Video excerpt (tests/data/real/ycbv, Asus Xtion 640x480), the
-// foam brick tracked with configs/track_real.json from the ground truth's first pose, all ten
-// frames per repetition (the table plane and the first frame's window included).
+// foam brick tracked with configs/track_real.json, all ten frames per repetition (the table plane
+// and the first frame's window or detection included): from the ground truth's first pose
+// (BM_RealRecording) or from the tracker's own detection (BM_RealRecordingFromDetection: the
+// model-sized segments, each with the proxy detection's hypotheses, detection.model_segments).
 //
 //   ./bench_track --benchmark_filter=BM_RealRecording
-void BM_RealRecording(benchmark::State& state) {
+void TrackRealRecording(benchmark::State& state, bool from_truth) {
   static const auto data = [] {
     const std::string root = std::string(MMH_BENCH_SOURCE_DIR) + "/tests/data/real/ycbv";
     RecordingFrameSource source(root + "/data/0000");
@@ -179,14 +181,17 @@ void BM_RealRecording(benchmark::State& state) {
   int64_t tracked = 0;
   for (auto _ : state) {
     ProxyTracker tracker(model, "foam brick", setup, config.tracker);
-    tracker.Initialize(truth.poses.front());
+    if (from_truth) tracker.Initialize(truth.poses.front());
     for (const RgbdFrame& f : frames) tracked += tracker.Track(f).status == TrackStatus::kTracked;
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frames.size()));
   state.counters["tracked_share"] =
       static_cast<double>(tracked) / (state.iterations() * static_cast<double>(frames.size()));
 }
+void BM_RealRecording(benchmark::State& state) { TrackRealRecording(state, true); }
+void BM_RealRecordingFromDetection(benchmark::State& state) { TrackRealRecording(state, false); }
 BENCHMARK(BM_RealRecording)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RealRecordingFromDetection)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace mmh::track
