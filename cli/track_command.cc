@@ -19,6 +19,7 @@
 #include "core/mesh_io.h"
 #include "core/staged_folder.h"
 #include "core/tum_io.h"
+#include "metrics/bop_results.h"
 #include "track/frame_source.h"
 #include "track/recording.h"
 #include "track/freenect_source.h"
@@ -47,6 +48,25 @@ void CheckModelSize(const TriangleMesh& model, const std::string& name,
                      FormatNumber(options.max_model_size) +
                      " m: a model in millimetres (BOP) needs --set track.model_scale=0.001");
   }
+}
+
+// The run's poses (tracked and predicted frames) as BOP results for comparison with published
+// methods: the inlier share as the score (0 for a predicted frame), no time per image (-1).
+std::vector<metrics::BopResult> BopResults(const track::TrackRun& run,
+                                           const track::RecordingFrameSource& recording,
+                                           int object, int scene) {
+  std::vector<metrics::BopResult> results;
+  for (const track::TrackFrameResult& f : run.frames) {
+    if (f.status == track::TrackStatus::kLost) continue;
+    metrics::BopResult r;
+    r.scene_id = scene;
+    r.im_id = recording.frames().at(f.index).image_id;
+    r.obj_id = object;
+    r.score = f.status == track::TrackStatus::kTracked ? f.inlier_share : 0.0;
+    r.camera_T_object = f.camera_T_proxy;
+    results.push_back(r);
+  }
+  return results;
 }
 
 // The object a recording's run follows: track.object, or the only one annotated.
@@ -113,12 +133,16 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   // A real recording with ground truth (BOP scene, YCB-Video folder): the followed object's truth
   // is written beside the trajectory (groundtruth.tum) and may give the first pose.
   std::optional<Trajectory> truth;
+  const track::RecordingFrameSource* recording_source = nullptr;
+  int object = 0;
   if (live) {
     source = std::make_unique<track::FreenectFrameSource>(track_config.freenect);
   } else if (track::DetectRecordingLayout(args.input)) {
     auto recording =
         std::make_unique<track::RecordingFrameSource>(args.input, track_config.track.frame_rate);
-    truth = recording->Truth(ChooseObject(*recording, track_config.track.object));
+    object = ChooseObject(*recording, track_config.track.object);
+    truth = recording->Truth(object);
+    recording_source = recording.get();
     source = std::move(recording);
   } else {
     source = std::make_unique<track::FolderFrameSource>(
@@ -161,6 +185,12 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
     WriteTum(stage / "groundtruth.tum", *truth,
              "camera_T_object of the followed object, from the recording's ground truth");
     written.push_back("groundtruth.tum");
+  }
+  if (recording_source) {
+    WriteFileAtomically(stage / "results_bop.csv",
+                        metrics::FormatBopResults(BopResults(run, *recording_source, object,
+                                                             metrics::SceneIdOfFolder(args.input).value_or(0))));
+    written.push_back("results_bop.csv");
   }
   written.push_back("config.resolved.json");
   written.push_back("run.json");

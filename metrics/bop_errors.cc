@@ -54,18 +54,38 @@ ModelPoints ErrorPoints(const TriangleMesh& mesh, int surface_points, int max_po
   return points;
 }
 
-double Mssd(const Rigid3& camera_T_est, const Rigid3& camera_T_gt, const ModelPoints& points,
-            const std::vector<Rigid3>& symmetries) {
+namespace {
+
+// The largest distance of a model point between the two poses [m].
+double MaxDistance(const Rigid3& camera_T_a, const Rigid3& camera_T_b, const ModelPoints& points) {
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Eigen::Vector3d x = points.row(i).transpose();
+    worst = std::max(worst, (camera_T_a * x - camera_T_b * x).norm());
+  }
+  return worst;
+}
+
+}  // namespace
+
+Rigid3 NearestSymmetricTruth(const Rigid3& camera_T_est, const Rigid3& camera_T_gt,
+                             const ModelPoints& points, const std::vector<Rigid3>& symmetries) {
+  Rigid3 nearest = camera_T_gt;
   double best = std::numeric_limits<double>::infinity();
   for (const Rigid3& truth : SymmetricTruths(camera_T_gt, symmetries)) {
-    double worst = 0.0;
-    for (Eigen::Index i = 0; i < points.rows(); ++i) {
-      const Eigen::Vector3d x = points.row(i).transpose();
-      worst = std::max(worst, (camera_T_est * x - truth * x).norm());
+    const double distance = MaxDistance(camera_T_est, truth, points);
+    if (distance < best) {
+      best = distance;
+      nearest = truth;
     }
-    best = std::min(best, worst);
   }
-  return best;
+  return nearest;
+}
+
+double Mssd(const Rigid3& camera_T_est, const Rigid3& camera_T_gt, const ModelPoints& points,
+            const std::vector<Rigid3>& symmetries) {
+  return MaxDistance(camera_T_est,
+                     NearestSymmetricTruth(camera_T_est, camera_T_gt, points, symmetries), points);
 }
 
 double Mspd(const Rigid3& camera_T_est, const Rigid3& camera_T_gt, const ModelPoints& points,

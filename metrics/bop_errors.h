@@ -9,8 +9,8 @@
 //          a rendered pixel is visible when the test image has no depth there or is not nearer
 //          than delta)
 //
-// Symmetries are the object's discrete symmetry transformations (BOP models_info.json
-// "symmetries_discrete"); the identity is always one. VSD works on distance images (distance of
+// Symmetries are the object's symmetry transformations (BOP models_info.json, discretised as
+// bop_toolkit does: metrics/model_symmetries.h); the identity is always one. VSD works on distance images (distance of
 // the 3-D point from the camera centre, not its depth), as bop_toolkit does.
 #pragma once
 
@@ -33,6 +33,11 @@ using ModelPoints = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 // deterministic low-discrepancy sequence: a cuboid of 8 vertices is otherwise measured at its
 // corners only).
 ModelPoints ErrorPoints(const TriangleMesh& mesh, int surface_points = 1000, int max_points = 2000);
+
+// Of camera_T_gt * object_T_symmetric over `symmetries` (and the identity), the pose MSSD measures
+// camera_T_est against: the one nearest it by the largest point distance (the first on a tie).
+Rigid3 NearestSymmetricTruth(const Rigid3& camera_T_est, const Rigid3& camera_T_gt,
+                             const ModelPoints& points, const std::vector<Rigid3>& symmetries);
 
 // MSSD [m] of camera_T_est against camera_T_gt over `points`, minimum over `symmetries`
 // (object_T_symmetric; empty: the identity only).

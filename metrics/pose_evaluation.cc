@@ -14,6 +14,8 @@ void PoseEvaluationOptions::Validate(const std::string& prefix) const {
   if (surface_points < 0) {
     ThrowBadValue(prefix + ".surface_points", std::to_string(surface_points), ">= 0");
   }
+  RequireProbability(min_visible_fraction, prefix + ".min_visible_fraction");
+  RequirePositive(max_symmetry_step, prefix + ".max_symmetry_step");
   bop.Validate(prefix + ".bop");
 }
 
@@ -23,6 +25,12 @@ ObjectEvaluation EvaluateObject(int object, std::vector<EvaluationFrame> frames,
   options.Validate("eval");
   ObjectEvaluation evaluation;
   evaluation.object = object;
+  evaluation.symmetries = static_cast<int>(symmetries.size());
+  const size_t all_frames = frames.size();
+  std::erase_if(frames, [&](const EvaluationFrame& f) {
+    return f.visible_fraction >= 0 && f.visible_fraction < options.min_visible_fraction;
+  });
+  evaluation.low_visibility = static_cast<int>(all_frames - frames.size());
   const ModelPoints points = ErrorPoints(model, options.surface_points);
   evaluation.points = static_cast<int>(points.rows());
   evaluation.diameter = Diameter(points);
@@ -42,8 +50,11 @@ ObjectEvaluation EvaluateObject(int object, std::vector<EvaluationFrame> frames,
     BopFrameErrors e;
     e.has_estimate = f.camera_T_estimate.has_value();
     if (e.has_estimate) {
-      e.rotation_deg = basic[i].rotation_deg;
-      e.translation = basic[i].translation;
+      const Rigid3 truth =
+          NearestSymmetricTruth(*f.camera_T_estimate, f.camera_T_truth, points, symmetries);
+      e.rotation_deg =
+          RotationAngle(f.camera_T_estimate->rotation, truth.rotation) * 180 / std::numbers::pi;
+      e.translation = (f.camera_T_estimate->translation - truth.translation).norm();
       e.add = basic[i].add;
       e.adds = basic[i].adds;
       e.mssd = Mssd(*f.camera_T_estimate, f.camera_T_truth, points, symmetries);
@@ -91,19 +102,74 @@ std::string FramesCsv(const std::vector<ObjectEvaluation>& objects) {
   return out.str();
 }
 
+namespace {
+
+// ar,ar_vsd,ar_mssd,ar_mspd,add_recall,adds_recall,recall_5deg_5cm,recall_2deg_2cm,
+// median_rotation_deg,median_translation_mm
+std::string RecallColumns(const BopRecall& r) {
+  return Number(r.ar) + ',' + (r.has_vsd ? Number(r.ar_vsd) : "") + ',' + Number(r.ar_mssd) + ',' +
+         Number(r.ar_mspd) + ',' + Number(r.add_recall) + ',' + Number(r.adds_recall) + ',' +
+         Number(r.recall_5deg_5cm) + ',' + Number(r.recall_2deg_2cm) + ',' +
+         Number(r.median_rotation_deg) + ',' + Number(r.median_translation * 1000);
+}
+
+constexpr char kRecallHeader[] =
+    "ar,ar_vsd,ar_mssd,ar_mspd,add_recall,adds_recall,recall_5deg_5cm,recall_2deg_2cm,"
+    "median_rotation_deg,median_translation_mm";
+
+}  // namespace
+
 std::string ObjectsCsv(const std::vector<ObjectEvaluation>& objects) {
   std::ostringstream out;
-  out << "object,frames,diameter_mm,ar,ar_vsd,ar_mssd,ar_mspd,add_recall,adds_recall,"
-         "recall_5deg_5cm,recall_2deg_2cm,median_rotation_deg,median_translation_mm\n";
+  out << "object,frames,diameter_mm," << kRecallHeader << '\n';
   for (const auto& o : objects) {
-    const BopRecall& r = o.recall;
-    out << o.object << ',' << r.frames << ',' << Number(o.diameter * 1000) << ',' << Number(r.ar)
-        << ',' << (r.has_vsd ? Number(r.ar_vsd) : "") << ',' << Number(r.ar_mssd) << ','
-        << Number(r.ar_mspd) << ',' << Number(r.add_recall) << ',' << Number(r.adds_recall) << ','
-        << Number(r.recall_5deg_5cm) << ',' << Number(r.recall_2deg_2cm) << ','
-        << Number(r.median_rotation_deg) << ',' << Number(r.median_translation * 1000) << '\n';
+    out << o.object << ',' << o.recall.frames << ',' << Number(o.diameter * 1000) << ','
+        << RecallColumns(o.recall) << '\n';
   }
   return out.str();
+}
+
+BopRecall PooledRecall(const std::vector<ObjectEvaluation>& objects) {
+  BopRecall pooled;
+  int vsd_frames = 0;
+  std::vector<double> rotations, translations;
+  for (const auto& o : objects) {
+    const BopRecall& r = o.recall;
+    pooled.frames += r.frames;
+    pooled.ar += r.frames * r.ar;
+    pooled.ar_mssd += r.frames * r.ar_mssd;
+    pooled.ar_mspd += r.frames * r.ar_mspd;
+    pooled.add_recall += r.frames * r.add_recall;
+    pooled.adds_recall += r.frames * r.adds_recall;
+    pooled.recall_5deg_5cm += r.frames * r.recall_5deg_5cm;
+    pooled.recall_2deg_2cm += r.frames * r.recall_2deg_2cm;
+    if (r.has_vsd) {
+      pooled.has_vsd = true;
+      pooled.ar_vsd += r.frames * r.ar_vsd;
+      vsd_frames += r.frames;
+    }
+    for (const BopFrameErrors& e : o.errors) {
+      if (!e.has_estimate) continue;
+      rotations.push_back(e.rotation_deg);
+      translations.push_back(e.translation);
+    }
+  }
+  if (pooled.frames > 0) {
+    for (double* v : {&pooled.ar, &pooled.ar_mssd, &pooled.ar_mspd, &pooled.add_recall,
+                      &pooled.adds_recall, &pooled.recall_5deg_5cm, &pooled.recall_2deg_2cm}) {
+      *v /= pooled.frames;
+    }
+  }
+  if (vsd_frames > 0) pooled.ar_vsd /= vsd_frames;
+  pooled.median_rotation_deg = Quantile(rotations, 0.5);
+  pooled.median_translation = Quantile(translations, 0.5);
+  return pooled;
+}
+
+std::string OverallCsv(const std::vector<ObjectEvaluation>& objects) {
+  const BopRecall r = PooledRecall(objects);
+  return std::string("objects,frames,") + kRecallHeader + '\n' + std::to_string(objects.size()) +
+         ',' + std::to_string(r.frames) + ',' + RecallColumns(r) + '\n';
 }
 
 nlohmann::json ToJson(const ObjectEvaluation& evaluation) {
@@ -111,6 +177,8 @@ nlohmann::json ToJson(const ObjectEvaluation& evaluation) {
   j["object"] = evaluation.object;
   j["diameter_mm"] = evaluation.diameter * 1000;
   j["error_points"] = evaluation.points;
+  j["symmetries"] = evaluation.symmetries;
+  j["low_visibility_frames_left_out"] = evaluation.low_visibility;
   return j;
 }
 

@@ -50,6 +50,10 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(seed_turn_deg, prefix + ".seed_turn_deg", "deg");
   RequireNonNegative(slide_drop, prefix + ".slide_drop");
   RequireNonNegative(rival_threshold, prefix + ".rival_threshold");
+  if (model_segments < 0) {
+    ThrowBadValue(prefix + ".model_segments", std::to_string(model_segments), ">= 0 (0: off)");
+  }
+  RequireNonNegative(segment_slack, prefix + ".segment_slack", "m");
   if (trusted_frames < 0) {
     ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
   }
@@ -318,25 +322,38 @@ std::vector<IcpResult> ProxyTracker::CoarseHypotheses(const IcpOptions& coarse_i
   return coarse_results;
 }
 
-std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& frame,
-                                                            const std::optional<Rigid3>& predicted,
-                                                            bool light) {
+// The state of one detection: the best candidate so far, the distinct poses refined, and the
+// verified poses (proxy_T_camera) with their scores (for the rival).
+struct ProxyTracker::DetectionRanking {
+  std::optional<Rigid3> predicted;
+  std::optional<Candidate> best;
+  std::vector<Rigid3> refined_poses;
+  std::vector<std::pair<Rigid3, double>> verified;
+};
+
+namespace {
+
+// Hypotheses converge to a few poses: each counts once.
+bool SamePose(const Rigid3& a, const Rigid3& b) {
+  return RotationAngle(a.rotation, b.rotation) < 0.1 && (a.translation - b.translation).norm() < 0.01;
+}
+
+}  // namespace
+
+IcpOptions ProxyTracker::CoarseIcpOptions() const {
   const DetectionOptions& o = options_.detection;
-  const Eigen::Quaterniond camera_R_table = camera_T_table_->rotation;
-  const double pi = std::numbers::pi;
   IcpOptions coarse_icp = search_icp_;
   coarse_icp.max_iterations = o.coarse_iterations;
   coarse_icp.start_distance = o.coarse_start_distance;
   coarse_icp.end_distance = o.coarse_end_distance;
   coarse_icp.shrink_iterations = std::max(1, o.coarse_iterations - 2);
-  // The coarse hypotheses (not in a light check: only the motion model's seeds and the twins).
-  std::vector<IcpResult> coarse_results;
-  size_t coarse_scored = 1;
-  if (!light) {
-    coarse_results = CoarseHypotheses(coarse_icp, &coarse_scored);
-    if (coarse_results.empty()) return std::nullopt;
-  }
-  // Rank the coarse results as verified poses are ranked (track/proxy_tracker.h, Score).
+  return coarse_icp;
+}
+
+std::vector<size_t> ProxyTracker::RankCoarse(const RgbdFrame& frame,
+                                             const std::vector<IcpResult>& coarse_results,
+                                             size_t coarse_scored) const {
+  // Ranked as verified poses are ranked (track/proxy_tracker.h, Score).
   std::vector<double> scores(coarse_results.size());
   for (size_t i = 0; i < coarse_results.size(); ++i) {
     const Visibility visibility =
@@ -351,64 +368,64 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return scores[a] > scores[b]; });
-  // Refine the best coarse results until `candidates` distinct poses are verified (hypotheses
-  // converge to a few poses: each counts once).
-  auto same_pose = [](const Rigid3& a, const Rigid3& b) {
-    return RotationAngle(a.rotation, b.rotation) < 0.1 &&
-           (a.translation - b.translation).norm() < 0.01;
-  };
+  return order;
+}
+
+bool ProxyTracker::Better(const Candidate& a, const std::optional<Candidate>& b,
+                          const std::optional<Rigid3>& predicted) const {
   // Verified beats unverified; then the score, except that among poses scoring within
   // switch_margin of each other the one nearer the prediction wins (when the views of a
   // near-symmetric proxy cannot tell its twins apart, continuity can), and within
   // far_switch_margin when they are more than 45 deg apart and the track is trusted (a twin: the
   // Soldier's half turn differs only by its rifle, which the hand often hides).
-  auto distance_to_prediction = [&](const Candidate& c) {
-    return RotationAngle(c.icp.proxy_T_camera.Inverse().rotation, predicted->rotation);
-  };
-  auto better = [&](const Candidate& a, const std::optional<Candidate>& b) {
-    if (!b) return true;
-    if (a.good != b->good) return a.good;
-    if (predicted) {
-      const bool far =
-          tracked_frames_ >= o.trusted_frames &&
-          RotationAngle(a.icp.proxy_T_camera.rotation, b->icp.proxy_T_camera.rotation) > pi / 4;
-      if (std::abs(a.Score() - b->Score()) <= (far ? o.far_switch_margin : o.switch_margin)) {
-        return distance_to_prediction(a) < distance_to_prediction(*b);
-      }
+  const DetectionOptions& o = options_.detection;
+  if (!b) return true;
+  if (a.good != b->good) return a.good;
+  if (predicted) {
+    auto distance_to_prediction = [&](const Candidate& c) {
+      return RotationAngle(c.icp.proxy_T_camera.Inverse().rotation, predicted->rotation);
+    };
+    const bool far = tracked_frames_ >= o.trusted_frames &&
+                     RotationAngle(a.icp.proxy_T_camera.rotation, b->icp.proxy_T_camera.rotation) >
+                         std::numbers::pi / 4;
+    if (std::abs(a.Score() - b->Score()) <= (far ? o.far_switch_margin : o.switch_margin)) {
+      return distance_to_prediction(a) < distance_to_prediction(*b);
     }
-    return a.Score() > b->Score();
-  };
-  // Candidates are refined and ranked on at most refine_points segmented points (and the skin
-  // points among data_ in proportion); only the winner is refined on all of them.
-  const size_t medium_scored = PrepareMediumData();
-  const std::vector<Eigen::Vector3f>& medium = detection_scratch_;
-  auto refine = [&](const Rigid3& proxy_T_camera, const IcpOptions& icp) {
-    return AlignPointToPlane(*model_, medium, medium_scored, options_.verification.skin_distance,
-                             proxy_T_camera, icp, sample_matches_);
-  };
-  std::vector<Rigid3> refined_poses;
-  std::optional<Candidate> best;
-  // The verified poses (proxy_T_camera) and their scores, for the rival below.
-  std::vector<std::pair<Rigid3, double>> verified;
-  // Verifies a refined pose and ranks it against the best so far.
-  auto weigh = [&](const IcpResult& refined) {
-    Candidate candidate = Verify(frame, refined);
-    if (better(candidate, best)) best = candidate;
-    if (candidate.good) verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
-  };
-  // The same for a pose not refined to before (each distinct pose counts once).
-  auto weigh_distinct = [&](const IcpResult& refined) {
-    if (std::any_of(refined_poses.begin(), refined_poses.end(),
-                    [&](const Rigid3& p) { return same_pose(p, refined.proxy_T_camera); })) {
-      return;
-    }
-    refined_poses.push_back(refined.proxy_T_camera);
-    weigh(refined);
-  };
+  }
+  return a.Score() > b->Score();
+}
+
+void ProxyTracker::Weigh(const RgbdFrame& frame, const IcpResult& refined,
+                         DetectionRanking* ranking) const {
+  Candidate candidate = Verify(frame, refined);
+  if (Better(candidate, ranking->best, ranking->predicted)) ranking->best = candidate;
+  if (candidate.good) {
+    ranking->verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
+  }
+}
+
+void ProxyTracker::WeighDistinct(const RgbdFrame& frame, const IcpResult& refined,
+                                 DetectionRanking* ranking) const {
+  for (const Rigid3& p : ranking->refined_poses) {
+    if (SamePose(p, refined.proxy_T_camera)) return;
+  }
+  ranking->refined_poses.push_back(refined.proxy_T_camera);
+  Weigh(frame, refined, ranking);
+}
+
+IcpResult ProxyTracker::RefineOnMedium(const Rigid3& proxy_T_camera, const IcpOptions& icp,
+                                       size_t medium_scored) const {
+  return AlignPointToPlane(*model_, detection_scratch_, medium_scored,
+                           options_.verification.skin_distance, proxy_T_camera, icp,
+                           sample_matches_);
+}
+
+std::vector<Rigid3> ProxyTracker::MotionSeeds(const std::optional<Rigid3>& predicted) const {
   // The motion model's poses are candidates too (the prediction and the last measured pose),
   // refined as the twins are: the coarse hypotheses sample yaw every 30 deg, and when a
   // near-symmetric twin scores as well as the truth (its distinguishing part under the hand), only
-  // a well-refined candidate near the prediction lets continuity decide (`better`).
+  // a well-refined candidate near the prediction lets continuity decide (Better).
+  const DetectionOptions& o = options_.detection;
   std::vector<Rigid3> seeds;
   if (predicted) seeds.push_back(*predicted);
   const std::optional<Rigid3>& last = motion_->last();
@@ -420,6 +437,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   // leave (seen from the side under the hand, the figure slides along its vertical faces, or rolls
   // a few degrees), which the coarse hypotheses, 30 deg apart, need not reach either.
   if (predicted && o.seed_shift > 0) {
+    const Eigen::Quaterniond camera_R_table = camera_T_table_->rotation;
     const Eigen::Vector3d up = camera_R_table * Eigen::Vector3d::UnitZ();
     const Eigen::Vector3d center = *predicted * model_->center().cast<double>();
     for (double sign : {-1.0, 1.0}) {
@@ -427,63 +445,148 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
     }
     for (int axis = 0; axis < 2; ++axis) {
       for (double sign : {-1.0, 1.0}) {
-        const Eigen::Quaterniond turn(Eigen::AngleAxisd(
-            sign * o.seed_turn_deg * pi / 180, camera_R_table * Eigen::Vector3d::Unit(axis)));
+        const Eigen::Quaterniond turn(
+            Eigen::AngleAxisd(sign * o.seed_turn_deg * std::numbers::pi / 180,
+                              camera_R_table * Eigen::Vector3d::Unit(axis)));
         seeds.emplace_back(turn * predicted->rotation,
                            center + turn * (predicted->translation - center));
       }
     }
   }
-  for (const Rigid3& seed : seeds) {
-    const IcpResult coarse_seed = refine(seed.Inverse(), coarse_icp);
-    weigh_distinct(refine(coarse_seed.proxy_T_camera, search_icp_));
-  }
-  const size_t seeded = refined_poses.size();
-  for (size_t c = 0;
-       c < order.size() && static_cast<int>(refined_poses.size() - seeded) < o.candidates &&
-       c < static_cast<size_t>(3 * o.candidates);
-       ++c) {
-    weigh_distinct(refine(coarse_results[order[c]].proxy_T_camera, search_icp_));
-  }
+  return seeds;
+}
+
+void ProxyTracker::WeighTwins(const RgbdFrame& frame, const IcpOptions& coarse_icp,
+                              size_t medium_scored, DetectionRanking* ranking) const {
   // Near-symmetric twins of the best pose: turned by quarter turns about the model's own axes
   // through its centre (a proxy built from bricks is often symmetric but for a small part, which
   // the coarse ranking cannot see).
-  if (best && o.twins) {
-    const Rigid3 camera_T_proxy = best->icp.proxy_T_camera.Inverse();
-    const Eigen::Vector3d center = model_->centroid().cast<double>();
-    const Candidate original = *best;
-    for (int axis = 0; axis < 3; ++axis) {
-      for (int quarter = 1; quarter <= 3; ++quarter) {
-        // proxy_T_twin: the turn about the centre, in the model's frame.
-        const Eigen::Quaterniond turn(
-            Eigen::AngleAxisd(quarter * pi / 2, Eigen::Vector3d::Unit(axis)));
-        const Rigid3 proxy_T_twin(turn, center - turn * center);
-        // Coarse first (the turn about the centre need not be the symmetry's), then fine.
-        const IcpResult coarse_twin = refine((camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp);
-        const IcpResult refined = refine(coarse_twin.proxy_T_camera, search_icp_);
-        if (same_pose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
-        weigh(refined);
-      }
+  const Rigid3 camera_T_proxy = ranking->best->icp.proxy_T_camera.Inverse();
+  const Eigen::Vector3d center = model_->centroid().cast<double>();
+  const Candidate original = *ranking->best;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int quarter = 1; quarter <= 3; ++quarter) {
+      // proxy_T_twin: the turn about the centre, in the model's frame.
+      const Eigen::Quaterniond turn(
+          Eigen::AngleAxisd(quarter * std::numbers::pi / 2, Eigen::Vector3d::Unit(axis)));
+      const Rigid3 proxy_T_twin(turn, center - turn * center);
+      // Coarse first (the turn about the centre need not be the symmetry's), then fine.
+      const IcpResult coarse_twin =
+          RefineOnMedium((camera_T_proxy * proxy_T_twin).Inverse(), coarse_icp, medium_scored);
+      const IcpResult refined = RefineOnMedium(coarse_twin.proxy_T_camera, search_icp_, medium_scored);
+      if (SamePose(refined.proxy_T_camera, original.icp.proxy_T_camera)) continue;
+      Weigh(frame, refined, ranking);
     }
   }
-  if (best) {
-    best = Verify(frame,
-                  AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                                    best->icp.proxy_T_camera, search_icp_, sample_matches_));
-    // The rival: the best-scoring verified pose more than 45 deg from the winner (a near-symmetric
-    // twin that the data could not rule out), kept as the turn from the winner in the model's
-    // frame (proxy_T_rival) and carried along with the track (Track: the twin evidence).
-    const Rigid3 camera_T_best = best->icp.proxy_T_camera.Inverse();
-    detection_rival_.reset();
-    double rival_score = 0.0;
-    for (const auto& [proxy_T_camera, score] : verified) {
-      const Rigid3 camera_T_pose = proxy_T_camera.Inverse();
-      if (RotationAngle(camera_T_pose.rotation, camera_T_best.rotation) <= pi / 4) continue;
-      if (detection_rival_ && score <= rival_score) continue;
-      detection_rival_ = camera_T_best.Inverse() * camera_T_pose;
-      rival_score = score;
+}
+
+void ProxyTracker::SetDetectionRival(const DetectionRanking& ranking) {
+  // The rival: the best-scoring verified pose more than 45 deg from the winner (a near-symmetric
+  // twin that the data could not rule out), kept as the turn from the winner in the model's
+  // frame (proxy_T_rival) and carried along with the track (Track: the twin evidence).
+  const Rigid3 camera_T_best = ranking.best->icp.proxy_T_camera.Inverse();
+  detection_rival_.reset();
+  double rival_score = 0.0;
+  for (const auto& [proxy_T_camera, score] : ranking.verified) {
+    const Rigid3 camera_T_pose = proxy_T_camera.Inverse();
+    if (RotationAngle(camera_T_pose.rotation, camera_T_best.rotation) <= std::numbers::pi / 4) {
+      continue;
+    }
+    if (detection_rival_ && score <= rival_score) continue;
+    detection_rival_ = camera_T_best.Inverse() * camera_T_pose;
+    rival_score = score;
+  }
+}
+
+std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& frame,
+                                                            const std::optional<Rigid3>& predicted,
+                                                            bool light) {
+  const DetectionOptions& o = options_.detection;
+  const IcpOptions coarse_icp = CoarseIcpOptions();
+  // The coarse hypotheses (not in a light check: only the motion model's seeds and the twins).
+  std::vector<IcpResult> coarse_results;
+  size_t coarse_scored = 1;
+  if (!light) {
+    coarse_results = CoarseHypotheses(coarse_icp, &coarse_scored);
+    if (coarse_results.empty()) return std::nullopt;
+  }
+  const std::vector<size_t> order = RankCoarse(frame, coarse_results, coarse_scored);
+  // Candidates are refined and ranked on at most refine_points segmented points (and the skin
+  // points among data_ in proportion); only the winner is refined on all of them.
+  const size_t medium_scored = PrepareMediumData();
+  DetectionRanking ranking;
+  ranking.predicted = predicted;
+  for (const Rigid3& seed : MotionSeeds(predicted)) {
+    const IcpResult coarse_seed = RefineOnMedium(seed.Inverse(), coarse_icp, medium_scored);
+    WeighDistinct(frame, RefineOnMedium(coarse_seed.proxy_T_camera, search_icp_, medium_scored),
+                  &ranking);
+  }
+  // The best coarse results, refined until `candidates` distinct poses besides the seeds'.
+  const size_t seeded = ranking.refined_poses.size();
+  for (size_t c = 0;
+       c < order.size() &&
+       static_cast<int>(ranking.refined_poses.size() - seeded) < o.candidates &&
+       c < static_cast<size_t>(3 * o.candidates);
+       ++c) {
+    WeighDistinct(frame,
+                  RefineOnMedium(coarse_results[order[c]].proxy_T_camera, search_icp_, medium_scored),
+                  &ranking);
+  }
+  if (ranking.best && o.twins) WeighTwins(frame, coarse_icp, medium_scored, &ranking);
+  if (ranking.best) {
+    ranking.best = Verify(
+        frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                                 ranking.best->icp.proxy_T_camera, search_icp_, sample_matches_));
+    SetDetectionRival(ranking);
+  }
+  return ranking.best;
+}
+
+std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAmongSegments(
+    const RgbdFrame& frame, const std::optional<Rigid3>& predicted) {
+  const DetectionOptions& o = options_.detection;
+  const Segmentation whole = segmentation_;
+  // A segment's points: at most the model's diameter apart (its bounding box's diagonal, plus
+  // the slack for depth noise and flying pixels at its edges).
+  const double max_extent = 2 * model_->radius() + o.segment_slack;
+  std::optional<Candidate> best;
+  double best_rank = 0.0;
+  std::optional<Segmentation> best_segment;
+  std::optional<Rigid3> best_rival;
+  int tried = 0;
+  for (size_t c = 0; c < whole.component_sizes.size() && tried < o.model_segments; ++c) {
+    Segmentation segment;
+    for (size_t i = 0; i < whole.points.size(); ++i) {
+      if (whole.components[i] != static_cast<int>(c)) continue;
+      segment.points.push_back(whole.points[i]);
+      segment.components.push_back(0);
+    }
+    if (static_cast<int>(segment.points.size()) < options_.verification.min_points) break;
+    Eigen::AlignedBox3f box;
+    for (const auto& p : segment.points) box.extend(p);
+    if (box.diagonal().norm() > max_extent) continue;
+    ++tried;
+    segment.component_sizes = {whole.component_sizes[c]};
+    segmentation_ = segment;
+    PrepareData();
+    std::optional<Candidate> candidate = Detect(frame, predicted, false);
+    if (!candidate) continue;
+    // The inlier share is of this segment's points, which a pose on a small part of another
+    // object also explains: the share of the model's visible surface that the depth confirms
+    // tells the object that fills the model.
+    const double rank = candidate->Score() + candidate->explained;
+    const bool better = !best || (candidate->good && !best->good) ||
+                        (candidate->good == best->good && rank > best_rank);
+    if (better) {
+      best = candidate;
+      best_rank = rank;
+      best_segment = segment;
+      best_rival = detection_rival_;
     }
   }
+  detection_rival_ = best_rival;
+  segmentation_ = best_segment ? *best_segment : whole;
+  PrepareData();
   return best;
 }
 
@@ -624,177 +727,200 @@ bool ProxyTracker::WeighRival(const RgbdFrame& frame, Candidate* chosen) {
   return true;
 }
 
-TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
-  const double pi = std::numbers::pi;
-  TrackFrameResult result;
-  result.index = frame.index;
-  result.timestamp = frame.timestamp;
-  auto lose = [&](const std::string& reason) {
-    result.status = TrackStatus::kLost;
-    result.reason = reason;
-    motion_->Reset();
-    predicted_frames_ = 0;
-    tracked_frames_ = 0;
-    recent_score_.reset();
-    SetRival(std::nullopt, true);
-    return result;
-  };
-  // The frame itself.
+TrackFrameResult ProxyTracker::Lose(TrackFrameResult result, const std::string& reason) {
+  result.status = TrackStatus::kLost;
+  result.reason = reason;
+  motion_->Reset();
+  predicted_frames_ = 0;
+  tracked_frames_ = 0;
+  recent_score_.reset();
+  SetRival(std::nullopt, true);
+  return result;
+}
+
+std::string ProxyTracker::FrameProblem(const RgbdFrame& frame) const {
   const PinholeIntrinsics& k = frame.depth_intrinsics;
   if (frame.depth.size() != static_cast<size_t>(k.width) * k.height || k.width <= 0 ||
       k.height <= 0) {
-    return lose("depth has " + std::to_string(frame.depth.size()) + " pixels, expected " +
-                std::to_string(k.width) + "x" + std::to_string(k.height) + " (its intrinsics)");
+    return "depth has " + std::to_string(frame.depth.size()) + " pixels, expected " +
+           std::to_string(k.width) + "x" + std::to_string(k.height) + " (its intrinsics)";
   }
   if (!(frame.depth_scale > 0) || !std::isfinite(frame.depth_scale)) {
-    return lose("depth_scale " + FormatNumber(frame.depth_scale) + " is not a positive number");
+    return "depth_scale " + FormatNumber(frame.depth_scale) + " is not a positive number";
   }
   if (intrinsics_ && !(*intrinsics_ == k)) {
-    return lose("frame size or intrinsics differ from the first frame's (" +
-                std::to_string(k.width) + "x" + std::to_string(k.height) + " vs " +
-                std::to_string(intrinsics_->width) + "x" + std::to_string(intrinsics_->height) +
-                ")");
+    return "frame size or intrinsics differ from the first frame's (" + std::to_string(k.width) +
+           "x" + std::to_string(k.height) + " vs " + std::to_string(intrinsics_->width) + "x" +
+           std::to_string(intrinsics_->height) + ")";
   }
   if (!intrinsics_) {
     try {
       k.Validate("frame intrinsics");
     } catch (const InputError& e) {
-      return lose(e.what());
+      return e.what();
     }
   }
-  std::string why;
   if (std::none_of(frame.depth.begin(), frame.depth.end(), [](uint16_t d) { return d != 0; })) {
-    return lose("depth all missing");
+    return "depth all missing";
   }
-  if (!EnsureTable(frame, &why)) return lose(why);
-  intrinsics_ = k;
+  return "";
+}
+
+void ProxyTracker::SegmentFrame(const RgbdFrame& frame, const ImageRect* window,
+                                TrackFrameResult* result) {
+  segmenter_.Segment(frame, &segmentation_, window);
+  result->points = static_cast<int>(segmentation_.points.size());
+  result->skin_points = static_cast<int>(segmentation_.skin_points.size());
+  PrepareData();
+}
+
+std::optional<ProxyTracker::Candidate> ProxyTracker::TrackFromPrediction(
+    const RgbdFrame& frame, const Rigid3& predicted, bool* windowed, TrackFrameResult* result,
+    std::string* why) {
+  const double pi = std::numbers::pi;
+  std::optional<Candidate> chosen;
+  const IcpResult icp =
+      AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
+                        predicted.Inverse(), options_.icp, sample_matches_);
+  Candidate candidate = Verify(frame, icp);
+  if (candidate.good) {
+    chosen = candidate;
+  } else {
+    *why = candidate.reason;
+  }
+  // A large correction of the prediction, or the periodic check, also asks the global detection
+  // (a jump can land the ICP on a near-symmetric twin of the true pose, which verifies).
+  const Rigid3 corrected = icp.proxy_T_camera.Inverse();
+  const DetectionOptions& d = options_.detection;
+  ++frames_since_detection_;
+  const bool large_correction =
+      RotationAngle(corrected.rotation, predicted.rotation) > d.recheck_rotation_deg * pi / 180 ||
+      (corrected.translation - predicted.translation).norm() > d.recheck_translation;
+  if (!chosen || !(large_correction || candidate.free_space_violation > d.recheck_free_space ||
+                   (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
+    return chosen;
+  }
+  frames_since_detection_ = 0;
+  // A light check (periodic, or the free space growing) refines only the motion model's seeds and
+  // the twins, all around the predicted proxy, so the window's data suffices; a large correction
+  // searches the whole play area.
+  const bool light = d.light_rechecks && !large_correction;
+  if (*windowed && !light) {
+    // Compare on the same data: the whole play area.
+    *windowed = false;
+    SegmentFrame(frame, nullptr, result);
+    chosen = Verify(frame, AlignPointToPlane(*model_, data_, scored_,
+                                             options_.verification.skin_distance,
+                                             chosen->icp.proxy_T_camera, options_.icp,
+                                             sample_matches_));
+  }
+  std::optional<Candidate> detected = Detect(frame, predicted, light);
+  const bool far = detected && RotationAngle(detected->icp.proxy_T_camera.rotation,
+                                             chosen->icp.proxy_T_camera.rotation) > pi / 4;
+  // A trusted track leaves for a twin only on the twin evidence (WeighRival).
+  const bool by_evidence = far && d.rival_threshold > 0 && tracked_frames_ >= d.trusted_frames;
+  if (detected && detected->good &&
+      (!chosen->good ||
+       (!by_evidence &&
+        detected->Score() > chosen->Score() + (far ? d.far_switch_margin : d.switch_margin)))) {
+    chosen = detected;
+    result->detected = true;
+    SetRival(detection_rival_, far);
+  } else if (!chosen->good) {
+    *why = chosen->reason;
+    chosen.reset();
+  } else if (detected && detected->good && far) {
+    // The tracked pose stays; the detection's pose is its rival.
+    SetRival(chosen->icp.proxy_T_camera * detected->icp.proxy_T_camera.Inverse(), false);
+  } else if (detected && detection_rival_) {
+    // The detection agrees with the track: its rival, turned onto the tracked pose.
+    SetRival(chosen->icp.proxy_T_camera * detected->icp.proxy_T_camera.Inverse() * *detection_rival_,
+             false);
+  }
+  return chosen;
+}
+
+std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAfterLoss(
+    const RgbdFrame& frame, const std::optional<Rigid3>& predicted, TrackFrameResult* result,
+    std::string* why) {
+  std::optional<Candidate> detected = options_.detection.model_segments > 0
+                                          ? DetectAmongSegments(frame, predicted)
+                                          : Detect(frame, predicted, false);
+  frames_since_detection_ = 0;
+  if (detected && detected->good) {
+    result->detected = true;
+    // The twin evidence survives a detection that continues the track (the tracked pose failed
+    // its verification on a frame, as under the hand it often does), unless it restarts it or
+    // turns it onto a twin.
+    SetRival(detection_rival_,
+             !predicted || RotationAngle(detected->icp.proxy_T_camera.Inverse().rotation,
+                                         predicted->rotation) > std::numbers::pi / 4);
+    return detected;
+  }
+  if (why->empty()) {
+    *why = detected ? "no pose hypothesis verified (best: " + detected->reason + ")"
+                    : "no segment large enough for a detection";
+  }
+  return std::nullopt;
+}
+
+void ProxyTracker::ReportTracked(const RgbdFrame& frame, const Candidate& chosen, bool slid,
+                                 TrackFrameResult* result) {
+  // The reported pose is the projective refinement of the chosen one; the motion model, the
+  // background and the checks keep the closest-point fit they were tuned on (refining that too
+  // lost 0.3-0.6 points of frames within 5 deg and 1 cm on four Soldier takes and made a
+  // 20-frame failure: docs/tracker.md).
+  const Rigid3 camera_T_proxy = chosen.icp.proxy_T_camera.Inverse();
+  Rigid3 camera_T_reported = camera_T_proxy;
+  if (options_.projective.iterations > 0) {
+    camera_T_reported =
+        RefineProjective(*model_, *intrinsics_, data_, scored_, options_.verification.skin_distance,
+                         chosen.icp.proxy_T_camera, options_.projective, sample_matches_)
+            .Inverse();
+  }
+  // A pose moved by the slide check is a measurement, but no motion: the velocity restarts.
+  motion_->Measure(camera_T_proxy, !result->detected && !slid);
+  predicted_frames_ = 0;
+  ++tracked_frames_;
+  result->status = TrackStatus::kTracked;
+  result->camera_T_proxy = camera_T_reported;
+  result->inlier_share = chosen.icp.inlier_share;
+  result->rms = chosen.icp.rms;
+  result->free_space_violation = chosen.free_space_violation;
+  result->iterations = chosen.icp.iterations;
+  segmenter_.UpdateBackground(frame, ProxyImage(camera_T_proxy, 0.02));
+}
+
+TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
+  TrackFrameResult result;
+  result.index = frame.index;
+  result.timestamp = frame.timestamp;
+  // The frame itself, and the table (estimated once, on the first frame that has one).
+  if (const std::string problem = FrameProblem(frame); !problem.empty()) {
+    return Lose(result, problem);
+  }
+  std::string why;
+  if (!EnsureTable(frame, &why)) return Lose(result, why);
+  intrinsics_ = frame.depth_intrinsics;
 
   // With a prediction, only the predicted proxy's image is examined.
   const std::optional<Rigid3> predicted = motion_->Predict();
   ImageRect window;
   if (predicted) window = ProxyImage(*predicted, options_.segmentation.window_margin);
-  segmenter_.Segment(frame, &segmentation_, predicted ? &window : nullptr);
-  result.points = static_cast<int>(segmentation_.points.size());
-  result.skin_points = static_cast<int>(segmentation_.skin_points.size());
-  PrepareData();
+  SegmentFrame(frame, predicted ? &window : nullptr, &result);
   bool windowed = predicted.has_value();
-  // The detection looks at the whole play area: a jump may have left the window.
-  auto segment_whole_play_area = [&] {
-    if (!windowed) return;
-    windowed = false;
-    segmenter_.Segment(frame, &segmentation_, nullptr);
-    result.points = static_cast<int>(segmentation_.points.size());
-    result.skin_points = static_cast<int>(segmentation_.skin_points.size());
-    PrepareData();
-  };
-
-  bool enough = result.points >= options_.verification.min_points;
   std::optional<Candidate> chosen;
-  if (predicted && enough) {
-    const IcpResult icp =
-        AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                          predicted->Inverse(), options_.icp, sample_matches_);
-    Candidate candidate = Verify(frame, icp);
-    if (candidate.good) {
-      chosen = candidate;
-    } else {
-      why = candidate.reason;
-    }
-    // A large correction of the prediction, or the periodic check, also asks the global detection
-    // (a jump can land the ICP on a near-symmetric twin of the true pose, which verifies).
-    const Rigid3 corrected = icp.proxy_T_camera.Inverse();
-    const DetectionOptions& d = options_.detection;
-    ++frames_since_detection_;
-    const bool large_correction =
-        RotationAngle(corrected.rotation, predicted->rotation) >
-            d.recheck_rotation_deg * std::numbers::pi / 180 ||
-        (corrected.translation - predicted->translation).norm() > d.recheck_translation;
-    if (chosen && (large_correction || candidate.free_space_violation > d.recheck_free_space ||
-                   (d.recheck_interval > 0 && frames_since_detection_ >= d.recheck_interval))) {
-      frames_since_detection_ = 0;
-      // A light check (periodic, or the free space growing) refines only the motion model's seeds
-      // and the twins, all around the predicted proxy, so the window's data suffices; a large
-      // correction searches the whole play area.
-      const bool light = d.light_rechecks && !large_correction;
-      if (windowed && !light) {
-        // Compare on the same data: the whole play area.
-        segment_whole_play_area();
-        chosen = Verify(
-            frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
-                                     chosen->icp.proxy_T_camera, options_.icp, sample_matches_));
-      }
-      std::optional<Candidate> detected = Detect(frame, predicted, light);
-      const bool far = detected && RotationAngle(detected->icp.proxy_T_camera.rotation,
-                                                 chosen->icp.proxy_T_camera.rotation) > pi / 4;
-      // A trusted track leaves for a twin only on the twin evidence (WeighRival).
-      const bool by_evidence = far && d.rival_threshold > 0 && tracked_frames_ >= d.trusted_frames;
-      if (detected && detected->good &&
-          (!chosen->good ||
-           (!by_evidence &&
-            detected->Score() > chosen->Score() + (far ? d.far_switch_margin : d.switch_margin)))) {
-        chosen = detected;
-        result.detected = true;
-        SetRival(detection_rival_, far);
-      } else if (!chosen->good) {
-        why = chosen->reason;
-        chosen.reset();
-      } else if (detected && detected->good && far) {
-        // The tracked pose stays; the detection's pose is its rival.
-        SetRival(chosen->icp.proxy_T_camera * detected->icp.proxy_T_camera.Inverse(), false);
-      } else if (detected && detection_rival_) {
-        // The detection agrees with the track: its rival, turned onto the tracked pose.
-        SetRival(
-            chosen->icp.proxy_T_camera * detected->icp.proxy_T_camera.Inverse() * *detection_rival_,
-            false);
-      }
-    }
+  if (predicted && result.points >= options_.verification.min_points) {
+    chosen = TrackFromPrediction(frame, *predicted, &windowed, &result, &why);
   }
-  if (!chosen) segment_whole_play_area();
-  enough = result.points >= options_.verification.min_points;
-  if (!chosen && enough) {
-    std::optional<Candidate> detected = Detect(frame, predicted, false);
-    frames_since_detection_ = 0;
-    if (detected && detected->good) {
-      chosen = detected;
-      result.detected = true;
-      // The twin evidence survives a detection that continues the track (the tracked pose failed
-      // its verification on a frame, as under the hand it often does), unless it restarts it or
-      // turns it onto a twin.
-      SetRival(detection_rival_,
-               !predicted || RotationAngle(detected->icp.proxy_T_camera.Inverse().rotation,
-                                           predicted->rotation) > pi / 4);
-    } else if (why.empty()) {
-      why = detected ? "no pose hypothesis verified (best: " + detected->reason + ")"
-                     : "no segment large enough for a detection";
-    }
-  }
-  // A pose moved by the slide check is a measurement, but no motion: the velocity restarts.
-  const bool slid = chosen && !result.detected && CheckSlide(frame, &*chosen);
-  if (chosen && WeighRival(frame, &*chosen)) result.detected = true;
+  // Lost or none: the detection looks at the whole play area (a jump may have left the window).
+  if (!chosen && windowed) SegmentFrame(frame, nullptr, &result);
+  const bool enough = result.points >= options_.verification.min_points;
+  if (!chosen && enough) chosen = DetectAfterLoss(frame, predicted, &result, &why);
   if (chosen) {
-    // The reported pose is the projective refinement of the chosen one; the motion model, the
-    // background and the checks keep the closest-point fit they were tuned on (refining that too
-    // lost 0.3-0.6 points of frames within 5 deg and 1 cm on four Soldier takes and made a
-    // 20-frame failure: docs/tracker.md).
-    const Rigid3 camera_T_proxy = chosen->icp.proxy_T_camera.Inverse();
-    Rigid3 camera_T_reported = camera_T_proxy;
-    if (options_.projective.iterations > 0) {
-      camera_T_reported =
-          RefineProjective(*model_, *intrinsics_, data_, scored_,
-                           options_.verification.skin_distance, chosen->icp.proxy_T_camera,
-                           options_.projective, sample_matches_)
-              .Inverse();
-    }
-    motion_->Measure(camera_T_proxy, !result.detected && !slid);
-    predicted_frames_ = 0;
-    ++tracked_frames_;
-    result.status = TrackStatus::kTracked;
-    result.camera_T_proxy = camera_T_reported;
-    result.inlier_share = chosen->icp.inlier_share;
-    result.rms = chosen->icp.rms;
-    result.free_space_violation = chosen->free_space_violation;
-    result.iterations = chosen->icp.iterations;
-    segmenter_.UpdateBackground(frame, ProxyImage(camera_T_proxy, 0.02));
+    const bool slid = !result.detected && CheckSlide(frame, &*chosen);
+    if (WeighRival(frame, &*chosen)) result.detected = true;
+    ReportTracked(frame, *chosen, slid, &result);
     return result;
   }
   if (!enough) {
@@ -812,7 +938,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
       return result;
     }
   }
-  return lose(why);
+  return Lose(result, why);
 }
 
 }  // namespace mmh::track

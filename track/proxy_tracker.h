@@ -105,6 +105,13 @@ struct DetectionOptions {
   double slide_drop = 0.02;
   double rival_drift = 0.03;
   double rival_threshold = 0.25;
+  // Real recordings (the object among others on a table): a detection after a loss tries up to
+  // model_segments segments, largest first, each no larger than the model's bounding sphere
+  // (diameter plus segment_slack [m]), on that segment's points alone, and keeps the verified
+  // pose that scores best with the share of the model's visible surface the depth confirms
+  // (0: the proxy's rule, the largest segment of the play volume is the proxy).
+  int model_segments = 0;
+  double segment_slack = 0.02;
 
   template <class V>
   void VisitFields(V& v) {
@@ -131,6 +138,8 @@ struct DetectionOptions {
     v("slide_drop", slide_drop);
     v("rival_drift", rival_drift);
     v("rival_threshold", rival_threshold);
+    v("model_segments", model_segments);
+    v("segment_slack", segment_slack);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -297,10 +306,54 @@ class ProxyTracker {
   // Refines camera_T_start on the detection's subsample, then for two iterations on all of this
   // frame's data, and verifies it (the rival's and the slide check's refinement).
   Candidate RefineOnFrame(const RgbdFrame& frame, const Rigid3& camera_T_start);
+  // Track's steps. Lose: the frame is lost (the motion, the rival and the recent score reset).
+  TrackFrameResult Lose(TrackFrameResult result, const std::string& reason);
+  // What makes the frame unusable (wrong size, other intrinsics, no depth), or "".
+  std::string FrameProblem(const RgbdFrame& frame) const;
+  // segmentation_, data_ and result's point counts, within `window` when given.
+  void SegmentFrame(const RgbdFrame& frame, const ImageRect* window, TrackFrameResult* result);
+  // The ICP from the prediction, verified, and the detection's check when the correction is
+  // large, the free space grows or the periodic check is due; nullopt (with *why) when no pose
+  // verifies. *windowed becomes false when the check segments the whole play area.
+  std::optional<Candidate> TrackFromPrediction(const RgbdFrame& frame, const Rigid3& predicted,
+                                               bool* windowed, TrackFrameResult* result,
+                                               std::string* why);
+  // The detection after a loss (or on the first frame): a verified pose, or nullopt with *why.
+  std::optional<Candidate> DetectAfterLoss(const RgbdFrame& frame,
+                                           const std::optional<Rigid3>& predicted,
+                                           TrackFrameResult* result, std::string* why);
+  // The chosen pose reported (projectively refined), measured by the motion model, and the
+  // background learnt around it; `slid`: moved by the slide check (no motion).
+  void ReportTracked(const RgbdFrame& frame, const Candidate& chosen, bool slid,
+                     TrackFrameResult* result);
+
   // The global detection; `predicted` (the motion model's pose, when there is one) breaks ties.
   // `light`: only the motion model's seeds and the twins, no coarse hypotheses.
   std::optional<Candidate> Detect(const RgbdFrame& frame, const std::optional<Rigid3>& predicted,
                                   bool light);
+  // Detect's steps: the coarse alignment's ICP options; the coarse results' order, best first;
+  // whether candidate a ranks before b; a refined pose verified and ranked (Weigh), once per
+  // distinct pose (WeighDistinct); an ICP on the detection's subsample; the motion model's seeds;
+  // the best pose's quarter-turn twins; the rival of the winner among the verified poses.
+  struct DetectionRanking;
+  IcpOptions CoarseIcpOptions() const;
+  std::vector<size_t> RankCoarse(const RgbdFrame& frame, const std::vector<IcpResult>& coarse_results,
+                                 size_t coarse_scored) const;
+  bool Better(const Candidate& a, const std::optional<Candidate>& b,
+              const std::optional<Rigid3>& predicted) const;
+  void Weigh(const RgbdFrame& frame, const IcpResult& refined, DetectionRanking* ranking) const;
+  void WeighDistinct(const RgbdFrame& frame, const IcpResult& refined,
+                     DetectionRanking* ranking) const;
+  IcpResult RefineOnMedium(const Rigid3& proxy_T_camera, const IcpOptions& icp,
+                           size_t medium_scored) const;
+  std::vector<Rigid3> MotionSeeds(const std::optional<Rigid3>& predicted) const;
+  void WeighTwins(const RgbdFrame& frame, const IcpOptions& coarse_icp, size_t medium_scored,
+                  DetectionRanking* ranking) const;
+  void SetDetectionRival(const DetectionRanking& ranking);
+  // The detection among the model-sized segments (DetectionOptions::model_segments); leaves
+  // segmentation_ and data_ holding the winner's segment.
+  std::optional<Candidate> DetectAmongSegments(const RgbdFrame& frame,
+                                               const std::optional<Rigid3>& predicted);
   // The coarse hypotheses' alignments (orientations about the table normal, placed at the largest
   // segment); *scored: how many of their points are scored. Empty without a large enough segment.
   std::vector<IcpResult> CoarseHypotheses(const IcpOptions& coarse_icp, size_t* scored) const;

@@ -48,6 +48,7 @@ void SegmentationOptions::Validate(const std::string& prefix) const {
                   "an integer in [1, 1000]");
   }
   RequirePositive(window_margin, prefix + ".window_margin", "m");
+  RequireNonNegative(max_depth_jump, prefix + ".max_depth_jump", "m");
   if (min_component_pixels < 1) {
     ThrowBadValue(prefix + ".min_component_pixels", std::to_string(min_component_pixels), ">= 1");
   }
@@ -152,24 +153,32 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
   if (out->foreground_pixels == 0) return;
 
   // Connected components; small ones are noise (flying pixels at edges, speckle).
-  const cv::Mat mask(mh, mw, CV_8U, mask_.data());
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<int> labels, areas;
+  if (options_.max_depth_jump > 0) {
+    DepthLimitedComponents(frame, region, mw, mh, &labels, &areas);
+  } else {
+    const cv::Mat mask(mh, mw, CV_8U, mask_.data());
+    cv::Mat cv_labels, stats, centroids;
+    const int count =
+        cv::connectedComponentsWithStats(mask, cv_labels, stats, centroids, 8, CV_32S);
+    labels.assign(cv_labels.begin<int>(), cv_labels.end<int>());
+    areas.resize(count);
+    for (int c = 0; c < count; ++c) areas[c] = stats.at<int>(c, cv::CC_STAT_AREA);
+  }
+  const int count = static_cast<int>(areas.size());
   std::vector<int> order;
   for (int c = 1; c < count; ++c) {
-    if (stats.at<int>(c, cv::CC_STAT_AREA) >= options_.min_component_pixels) {
+    if (areas[c] >= options_.min_component_pixels) {
       order.push_back(c);
     } else {
-      out->dropped_pixels += stats.at<int>(c, cv::CC_STAT_AREA);
+      out->dropped_pixels += areas[c];
     }
   }
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-    return stats.at<int>(a, cv::CC_STAT_AREA) > stats.at<int>(b, cv::CC_STAT_AREA);
-  });
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return areas[a] > areas[b]; });
   std::vector<int> rank(count, -1);
   for (size_t r = 0; r < order.size(); ++r) {
     rank[order[r]] = static_cast<int>(r);
-    out->component_sizes.push_back(stats.at<int>(order[r], cv::CC_STAT_AREA));
+    out->component_sizes.push_back(areas[order[r]]);
   }
   const float inverse_fx = static_cast<float>(1 / intrinsics_.fx);
   const float inverse_fy = static_cast<float>(1 / intrinsics_.fy);
@@ -179,7 +188,7 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
     for (int mx = 0; mx < mw; ++mx) {
       const uint8_t m = mask_[static_cast<size_t>(my) * mw + mx];
       if (m == 0) continue;
-      const int r = rank[labels.at<int>(my, mx)];
+      const int r = rank[labels[static_cast<size_t>(my) * mw + mx]];
       if (r < 0) continue;
       const int x = region.x0 + mx * step;
       const float z = frame.depth[static_cast<size_t>(y) * width + x] * scale;
@@ -192,6 +201,74 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
         out->components.push_back(r);
       }
     }
+  }
+}
+
+void Segmenter::DepthLimitedComponents(const RgbdFrame& frame, const ImageRect& region, int mw,
+                                       int mh, std::vector<int>* labels,
+                                       std::vector<int>* areas) const {
+  // Union-find over the mask's pixels, joining 8-neighbours (as OpenCV's components do) whose
+  // depths differ by at most max_depth_jump; labels are numbered in raster order of each
+  // component's first pixel (0: background), as OpenCV numbers them.
+  const int step = options_.pixel_step, width = intrinsics_.width;
+  const uint16_t jump = static_cast<uint16_t>(
+      std::min(65535.0, std::floor(options_.max_depth_jump / frame.depth_scale)));
+  const size_t n = static_cast<size_t>(mw) * mh;
+  std::vector<int> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto depth = [&](int mx, int my) {
+    return frame.depth[static_cast<size_t>(region.y0 + my * step) * width + region.x0 + mx * step];
+  };
+  // A pixel at a depth step (some 8-neighbour's depth differs by more than the jump) joins no
+  // other: the sensor interpolates across an object's outline (flying pixels), which would
+  // otherwise bridge the step in small jumps.
+  auto at_step = [&](int mx, int my, uint16_t d) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int nx = mx + dx, ny = my + dy;
+        if (nx < 0 || ny < 0 || nx >= mw || ny >= mh) continue;
+        const uint16_t e = depth(nx, ny);
+        if (e != 0 && (d > e ? d - e : e - d) > jump) return true;
+      }
+    }
+    return false;
+  };
+  for (int my = 0; my < mh; ++my) {
+    for (int mx = 0; mx < mw; ++mx) {
+      const int i = my * mw + mx;
+      if (mask_[i] == 0) continue;
+      const uint16_t d = depth(mx, my);
+      if (at_step(mx, my, d)) continue;
+      // The neighbours already visited: left, upper left, upper, upper right.
+      const int neighbours[4][2] = {{-1, 0}, {-1, -1}, {0, -1}, {1, -1}};
+      for (const auto& [dx, dy] : neighbours) {
+        const int nx = mx + dx, ny = my + dy;
+        if (nx < 0 || ny < 0 || nx >= mw) continue;
+        const int j = ny * mw + nx;
+        if (mask_[j] == 0) continue;
+        const uint16_t e = depth(nx, ny);
+        if ((d > e ? d - e : e - d) > jump || at_step(nx, ny, e)) continue;
+        const int a = find(i), b = find(j);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+  }
+  labels->assign(n, 0);
+  areas->assign(1, 0);
+  std::vector<int> label_of_root(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (mask_[i] == 0) continue;
+    const int root = find(static_cast<int>(i));
+    if (label_of_root[root] == 0) {
+      label_of_root[root] = static_cast<int>(areas->size());
+      areas->push_back(0);
+    }
+    (*labels)[i] = label_of_root[root];
+    ++(*areas)[label_of_root[root]];
   }
 }
 

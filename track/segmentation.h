@@ -42,6 +42,11 @@ struct SegmentationOptions {
   int skin_cb_max = 127;
   // Connected components (8-neighbourhood of foreground pixels) with fewer pixels are dropped.
   int min_component_pixels = 25;
+  // Neighbouring pixels belong to one component only when their depths differ by at most
+  // max_depth_jump [m] (0: any depth, the image's connectivity alone). On a real cluttered table
+  // objects touch in the image without touching in space (a box standing in front of a keyboard):
+  // without this they form one segment that no single object's model explains.
+  double max_depth_jump = 0.0;
   // While tracking, only the predicted proxy's image is segmented: its bounding sphere grown by
   // window_margin [m] (more than a frame's motion after the prediction).
   double window_margin = 0.03;
@@ -63,6 +68,7 @@ struct SegmentationOptions {
     v("skin_cb_min", skin_cb_min);
     v("skin_cb_max", skin_cb_max);
     v("min_component_pixels", min_component_pixels);
+    v("max_depth_jump", max_depth_jump);
     v("window_margin", window_margin);
   }
   void Validate(const std::string& prefix) const;
@@ -108,6 +114,11 @@ class Segmenter {
   const SegmentationOptions& options() const { return options_; }
 
  private:
+  // Connected components of mask_ (mw x mh) that join neighbours only across depth steps of at
+  // most max_depth_jump: per mask pixel its label (0: background), per label its pixel count.
+  void DepthLimitedComponents(const RgbdFrame& frame, const ImageRect& region, int mw, int mh,
+                              std::vector<int>* labels, std::vector<int>* areas) const;
+
   SegmentationOptions options_;
   TrackSetup setup_;
   bool has_table_ = false;

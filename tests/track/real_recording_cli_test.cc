@@ -30,7 +30,7 @@ struct Scores {
 };
 
 Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, const std::string& init) {
-  const fs::path out = dir / ("track_" + init);
+  const fs::path out = dir / ("track_" + init + std::to_string(object));
   const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
                             (kReal / "models" / model).string() + " --config " + kPreset +
                             " --set track.object=" + std::to_string(object) +
@@ -39,7 +39,7 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
   const auto summary = nlohmann::json::parse(ReadBytes(out / "track_summary.json"));
   EXPECT_EQ(summary["init"], init);
   EXPECT_TRUE(fs::exists(out / "groundtruth.tum"));
-  const fs::path eval = dir / ("eval_" + init);
+  const fs::path eval = dir / ("eval_" + init + std::to_string(object));
   const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model " +
                              (kReal / "models" / model).string() + " --estimate " +
                              (out / "trajectory.tum").string() + " --set track.object=" +
@@ -60,13 +60,50 @@ TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromTheTruthsFirstPose) {
     const Scores truth = TrackAndEval(dir, object, model, "truth");
     // Measured 1.13 deg / 1.71 mm (box) and 2.52 deg / 1.97 mm (brick), all 10 frames within
     // 5 deg / 5 cm, AR 1.0 and 0.974 (docs/tracker.md, "Real recordings"); bounds with margin.
-    // From the tracker's own detection both are lost on every frame (not tested here: see the
-    // doc).
     EXPECT_LT(truth.median_rotation_deg, 4.0);
     EXPECT_LT(truth.median_translation_mm, 4.0);
     EXPECT_GE(truth.recall_5deg_5cm, 0.9);
     EXPECT_GE(truth.ar, 0.9);
   }
+}
+
+TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
+  TempDir dir;
+  // The detection among the model-sized segments (configs/track_real.json). Measured: gelatin box
+  // 1.25 deg / 1.73 mm, brick 2.37 deg / 1.59 mm (errors against the nearest symmetric truth,
+  // models/models_info.json: the detection picks a half turn of the brick's square prism), all 10
+  // frames within 5 deg / 5 cm, AR 1.0 and 0.979 (docs/tracker.md). The goals: median
+  // <= 2 deg, <= 5 mm, >= 90 % within 5 deg / 5 cm; the brick's rotation misses the 2 deg by the
+  // cuboid model's bias (2.47 deg from the truth's first pose too).
+  const Scores box = TrackAndEval(dir, 8, "009_gelatin_box.obj", "detection");
+  EXPECT_LT(box.median_rotation_deg, 2.0);
+  EXPECT_LT(box.median_translation_mm, 5.0);
+  EXPECT_GE(box.recall_5deg_5cm, 0.9);
+  EXPECT_GE(box.ar, 0.9);
+  const Scores brick = TrackAndEval(dir, 21, "061_foam_brick.obj", "detection");
+  EXPECT_LT(brick.median_rotation_deg, 3.5);
+  EXPECT_LT(brick.median_translation_mm, 5.0);
+  EXPECT_GE(brick.recall_5deg_5cm, 0.9);
+  EXPECT_GE(brick.ar, 0.9);
+
+  // Both objects in one call from the runs' BOP result files: the same per-object figures (R to
+  // 9 digits), and the pooled row weighs them by frames.
+  std::string both = ReadBytes(dir / "track_detection8" / "results_bop.csv");
+  const std::string brick_results = ReadBytes(dir / "track_detection21" / "results_bop.csv");
+  both += brick_results.substr(brick_results.find('\n') + 1);
+  WriteText(dir / "both.csv", both);
+  const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model 8=" +
+                             (kReal / "models" / "009_gelatin_box.obj").string() + " --model 21=" +
+                             (kReal / "models" / "061_foam_brick.obj").string() + " --estimate " +
+                             (dir / "both.csv").string() + " --out " + (dir / "both").string());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto json = nlohmann::json::parse(ReadBytes(dir / "both" / "eval.json"));
+  ASSERT_EQ(json["objects"].size(), 2u);
+  EXPECT_NEAR(json["objects"][0]["median_rotation_deg"].get<double>(), box.median_rotation_deg, 1e-4);
+  EXPECT_NEAR(json["objects"][1]["ar"].get<double>(), brick.ar, 1e-9);
+  EXPECT_EQ(json["overall"]["frames"], 20);
+  EXPECT_NEAR(json["overall"]["ar"].get<double>(), (box.ar + brick.ar) / 2, 1e-9);
+  EXPECT_TRUE(fs::exists(dir / "both" / "eval_overall.csv"));
 }
 
 TEST(RealRecordingCliTest, EvalOfTheTruthItselfIsPerfect) {

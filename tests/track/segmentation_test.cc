@@ -1,0 +1,82 @@
+// The segmentation's connected components with and without the depth limit
+// (SegmentationOptions::max_depth_jump): two blocks that touch in the image at different heights
+// above the table are one component by the image's connectivity and two with the limit, each
+// without its outline (the pixels at a depth step join nothing and are dropped as small
+// components).
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <numbers>
+
+#include "core/error.h"
+#include "track/segmentation.h"
+
+namespace mmh::track {
+namespace {
+
+// An 80 x 80 px camera looking straight down at a table 1 m below it; block A (columns 20-39) is
+// 10 cm high, block B (columns 40-59) 20 cm high, both over rows 20-59.
+RgbdFrame TwoBlocks() {
+  RgbdFrame frame;
+  PinholeIntrinsics& k = frame.depth_intrinsics;
+  k.width = k.height = 80;
+  k.fx = k.fy = 100;
+  k.cx = k.cy = 40;
+  frame.color_intrinsics = k;
+  frame.depth_scale = 0.001;
+  frame.depth.assign(80 * 80, 1000);
+  for (int v = 20; v < 60; ++v) {
+    for (int u = 20; u < 60; ++u) frame.depth[v * 80 + u] = u < 40 ? 900 : 800;
+  }
+  return frame;
+}
+
+Segmentation SegmentTwoBlocks(double max_depth_jump) {
+  TrackSetup setup;
+  setup.play_area_width = setup.play_area_depth = 1.0;
+  setup.like_box_length = 0;
+  SegmentationOptions options;
+  options.skin = false;
+  options.background = false;
+  options.max_depth_jump = max_depth_jump;
+  Segmenter segmenter(options, setup);
+  // The table's z axis points at the camera: a half turn about x, its origin 1 m ahead.
+  const Rigid3 camera_T_table(
+      Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(0, 0, 1));
+  const RgbdFrame frame = TwoBlocks();
+  segmenter.SetTable(camera_T_table, frame.depth_intrinsics);
+  Segmentation segmentation;
+  segmenter.Segment(frame, &segmentation);
+  return segmentation;
+}
+
+TEST(SegmentationTest, ImageConnectivityJoinsBlocksAtDifferentDepths) {
+  const Segmentation s = SegmentTwoBlocks(0.0);
+  ASSERT_EQ(s.component_sizes.size(), 1u);
+  EXPECT_EQ(s.component_sizes[0], 40 * 40);
+  EXPECT_EQ(s.dropped_pixels, 0);
+}
+
+TEST(SegmentationTest, DepthLimitSeparatesBlocksAndDropsTheirOutlines) {
+  const Segmentation s = SegmentTwoBlocks(0.01);
+  // Each block keeps its 18 x 38 inner pixels: its outline borders the table (10 or 20 cm lower)
+  // or the other block (10 cm apart).
+  ASSERT_EQ(s.component_sizes.size(), 2u);
+  EXPECT_EQ(s.component_sizes[0], 18 * 38);
+  EXPECT_EQ(s.component_sizes[1], 18 * 38);
+  EXPECT_EQ(s.dropped_pixels, 40 * 40 - 2 * 18 * 38);
+  // The blocks' points keep their depths: component 0 (the first found, A) at 0.9 m.
+  for (size_t i = 0; i < s.points.size(); ++i) {
+    EXPECT_FLOAT_EQ(s.points[i].z(), s.components[i] == 0 ? 0.9f : 0.8f);
+  }
+}
+
+TEST(SegmentationTest, NegativeDepthJumpIsRejected) {
+  SegmentationOptions options;
+  options.max_depth_jump = -0.01;
+  EXPECT_THROW(options.Validate("segmentation"), InputError);
+}
+
+}  // namespace
+}  // namespace mmh::track
