@@ -1,7 +1,6 @@
 // `mmh track`: the tracker on a frame source (a TUM RGB-D folder, or a Kinect v1 through
 // libfreenect); writes trajectory.tum, status.csv, annotation.csv, track_summary.json,
 // config.resolved.json and run.json (docs/tracker.md).
-#include <tbb/global_control.h>
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
@@ -96,15 +95,9 @@ std::optional<Rigid3> FirstTruePose(const std::optional<Trajectory>& truth,
 
 void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   namespace fs = std::filesystem;
-  Config config;
-  if (!args.common.config_file.empty()) config = Config::Load(args.common.config_file);
-  for (const auto& set : args.common.sets) config.Set(set);
+  const Config config = LoadConfig(args.common);
   const track::TrackConfig track_config = track::TrackConfig::FromConfig(config);
-  std::unique_ptr<tbb::global_control> threads;
-  if (args.common.threads > 0) {
-    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                    args.common.threads);
-  }
+  const auto threads = LimitThreads(args.common.threads);
 
   // Everything is read and checked before the first frame. Slider-only mode (track.proxy false,
   // annotation sessions) needs no model; one given is still read and checked.
@@ -157,16 +150,12 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   const fs::path out = args.common.out_dir;
   StagedFolder staged(out);
   const bool bar = ShowProgress(args.common);
-  const track::TrackRun run = track::RunTracking(*source, model, args.model, setup, calibrated,
-                                                 track_config, [&](int done, int total) {
-                                                   if (bar && done % 10 == 0) {
-                                                     std::cerr << "\rtrack: " << done;
-                                                     if (total > 0) std::cerr << " / " << total;
-                                                     std::cerr << " frames" << std::flush;
-                                                   }
-                                                 },
-                                                 FirstTruePose(truth, track_config.track));
-  if (bar) std::cerr << '\n';
+  ProgressBar progress_bar(bar, "track");
+  const track::TrackRun run = track::RunTracking(
+      *source, model, args.model, setup, calibrated, track_config,
+      [&](int done, int total) { progress_bar.Update(done, total); },
+      FirstTruePose(truth, track_config.track));
+  progress_bar.Finish();
 
   if (run.summary.frames == 0) {
     throw InputError("--input " + args.input + ": the source delivered no frame");

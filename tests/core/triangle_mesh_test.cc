@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "tests/test_meshes.h"
 
 namespace mmh {
 namespace {
@@ -18,26 +19,9 @@ using ::testing::HasSubstr;
 
 // An axis-aligned box [0, sx] x [0, sy] x [0, sz] with shared vertices and outward faces, built by
 // hand (the builders live in sim/ and are tested there).
+// A box from the origin to (sx, sy, sz).
 TriangleMesh Box(double sx, double sy, double sz, Rgb8 color = {10, 20, 30}) {
-  TriangleMesh mesh;
-  mesh.vertices.resize(8, 3);
-  for (int k = 0; k < 2; ++k) {
-    for (int j = 0; j < 2; ++j) {
-      for (int i = 0; i < 2; ++i) {
-        mesh.vertices.row(i + 2 * j + 4 * k) << static_cast<float>(i * sx),
-            static_cast<float>(j * sy), static_cast<float>(k * sz);
-      }
-    }
-  }
-  mesh.faces.resize(12, 3);
-  mesh.faces << 0, 2, 3, 0, 3, 1,  // -z
-      4, 5, 7, 4, 7, 6,            // +z
-      0, 1, 5, 0, 5, 4,            // -y
-      2, 6, 7, 2, 7, 3,            // +y
-      0, 4, 6, 0, 6, 2,            // -x
-      1, 3, 7, 1, 7, 5;            // +x
-  SetColor(&mesh, color);
-  return mesh;
+  return test_util::BoxMesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(sx, sy, sz), color);
 }
 
 TEST(MeshTest, BoxHelperIsClosedWithOutwardNormals) {

@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "metrics/tracking_metrics.h"
+#include "tests/test_meshes.h"
 
 namespace mmh::metrics {
 namespace {
@@ -32,17 +33,9 @@ TriangleMesh SquareMesh(double a) {
   return m;
 }
 
+// A box with half extents (hx, hy, hz) about the origin.
 TriangleMesh Box(double hx, double hy, double hz) {
-  TriangleMesh m;
-  m.vertices.resize(8, 3);
-  for (int i = 0; i < 8; ++i) {
-    m.vertices.row(i) << (i & 1 ? hx : -hx), (i & 2 ? hy : -hy), (i & 4 ? hz : -hz);
-  }
-  m.faces.resize(12, 3);
-  m.faces << 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4,
-      6, 1, 3, 5, 3, 7, 5;
-  m.face_colors.setConstant(12, 3, 128);
-  return m;
+  return test_util::CentredBox(2 * hx, 2 * hy, 2 * hz, {128, 128, 128});
 }
 
 PinholeIntrinsics SmallCamera() {

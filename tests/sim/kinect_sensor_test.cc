@@ -14,32 +14,18 @@
 #include <numeric>
 
 #include "core/error.h"
-#include "tests/sim/test_meshes.h"
+#include "tests/test_meshes.h"
 
 namespace mmh::sim {
 namespace {
 
 using ::testing::HasSubstr;
 
-using test_meshes::Quad;
+using test_util::Quad;
 
 // An axis-aligned box centred at the origin.
 TriangleMesh Box(double sx, double sy, double sz) {
-  TriangleMesh mesh;
-  mesh.vertices.resize(8, 3);
-  for (int i = 0; i < 8; ++i) {
-    mesh.vertices.row(i) << ((i & 1) ? sx : -sx) / 2, ((i & 2) ? sy : -sy) / 2,
-        ((i & 4) ? sz : -sz) / 2;
-  }
-  mesh.faces.resize(12, 3);
-  mesh.faces << 0, 2, 1, 1, 2, 3,  // z-
-      4, 5, 6, 5, 7, 6,            // z+
-      0, 1, 4, 1, 5, 4,            // y-
-      2, 6, 3, 3, 6, 7,            // y+
-      0, 4, 2, 2, 4, 6,            // x-
-      1, 3, 5, 3, 7, 5;            // x+
-  mesh.face_colors.setConstant(12, 3, 60);
-  return mesh;
+  return test_util::CentredBox(sx, sy, sz, {60, 60, 60});
 }
 
 // Camera at the world origin looking along +z (world = camera frame).

@@ -12,14 +12,14 @@
 
 #include "core/error.h"
 #include "sim/kinect_sensor.h"
-#include "tests/sim/test_meshes.h"
+#include "tests/test_meshes.h"
 
 namespace mmh::sim {
 namespace {
 
 using ::testing::HasSubstr;
 
-using test_meshes::Quad;
+using test_util::Quad;
 
 // A wall facing the camera (camera at the origin looking along +z) at depth z.
 Rigid3 WallAt(double z) {

@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "tests/test_meshes.h"
 #include "tests/test_util.h"
 #include "tests/track/sim_take.h"
 #include "track/proxy_tracker.h"
@@ -22,19 +23,10 @@ namespace {
 using test_util::ErrorOf;
 using ::testing::HasSubstr;
 
+// A box standing on z = 0, centred in x and y.
 TriangleMesh Box(float sx, float sy, float sz) {
-  TriangleMesh box;
-  box.vertices.resize(8, 3);
-  for (int i = 0; i < 8; ++i) {
-    box.vertices.row(i) << (i & 1 ? sx / 2 : -sx / 2), (i & 2 ? sy / 2 : -sy / 2),
-        (i & 4 ? sz : 0.0f);
-  }
-  const uint32_t faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  box.faces.resize(12, 3);
-  for (int f = 0; f < 12; ++f) box.faces.row(f) << faces[f][0], faces[f][1], faces[f][2];
-  box.face_colors.setConstant(12, 3, 200);
-  return box;
+  return test_util::BoxMesh(Eigen::Vector3d(-sx / 2, -sy / 2, 0), Eigen::Vector3d(sx / 2, sy / 2, sz),
+                            {200, 200, 200});
 }
 
 TEST(ProxyModelTest, SamplesLieOnTheSurfaceWithOutwardNormals) {
