@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "cli/command_registry.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "study/paper_audit.h"
@@ -19,8 +20,7 @@ struct CheckPaperArgs {
   std::string reported =
       (std::filesystem::path(MMH_SOURCE_DIR) / "configs" / "paper_reported.json").string();
   std::string paper;
-  std::string out_dir;
-  bool quiet = false;
+  CommonFlags common;  // --out (optional), --quiet
 };
 
 void RunCheckPaper(const CheckPaperArgs& args, const std::vector<std::string>& argv) {
@@ -28,8 +28,8 @@ void RunCheckPaper(const CheckPaperArgs& args, const std::vector<std::string>& a
   std::optional<std::filesystem::path> paper;
   if (!args.paper.empty()) paper = args.paper;
   const study::PaperAudit audit = study::AuditPaperFile(args.reported, paper);
-  if (!args.out_dir.empty()) {
-    const std::filesystem::path out = args.out_dir;
+  if (!args.common.out_dir.empty()) {
+    const std::filesystem::path out = args.common.out_dir;
     nlohmann::json resolved = {
         {"reported", args.reported},
         {"paper", args.paper.empty() ? nlohmann::json(nullptr) : nlohmann::json(args.paper)}};
@@ -41,10 +41,10 @@ void RunCheckPaper(const CheckPaperArgs& args, const std::vector<std::string>& a
     WriteFileAtomically(out / "run.json",
                         Provenance(argv, resolved, 1, {{"total", seconds}}).dump(2) + "\n");
   }
-  if (!args.quiet) {
+  if (!args.common.quiet) {
     std::cout << audit.Table();
-    if (!args.out_dir.empty()) {
-      std::cout << "written: " << args.out_dir
+    if (!args.common.out_dir.empty()) {
+      std::cout << "written: " << args.common.out_dir
                 << "/{paper_audit.json, config.resolved.json, run.json}\n";
     }
   }
@@ -61,8 +61,12 @@ void AddCheckPaperCommand(CLI::App& app, const std::vector<std::string>& argv) {
                   "JSON of the reported numbers (default: configs/paper_reported.json)");
   cmd->add_option("--paper", args->paper,
                   "The paper as text: every quote is looked up in it (optional)");
-  cmd->add_option("--out", args->out_dir, "Output folder for paper_audit.json (optional)");
-  cmd->add_flag("--quiet", args->quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "",
+                  .set = false,
+                  .out_help = "Output folder for paper_audit.json (optional)",
+                  .out_required = false,
+                  .threads = false});
   cmd->callback([args, argv] { RunCheckPaper(*args, argv); });
 }
 

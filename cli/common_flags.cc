@@ -18,16 +18,14 @@ void AddCommonFlags(CLI::App* command, CommonFlags* flags, const CommonFlagsSpec
     if (spec.config_required) config->required();
   }
   if (spec.set) {
-    command->add_option("--set", flags->sets, "Override: key.path=value (JSON value), repeatable")
-        ->take_all();
+    command->add_option("--set", flags->sets, spec.set_help)->take_all();
   }
   if (!spec.out_help.empty()) {
     CLI::Option* out = command->add_option("--out", flags->out_dir, spec.out_help);
     if (spec.out_required) out->required();
   }
   if (spec.threads) {
-    command
-        ->add_option("--threads", flags->threads, "Worker threads, 1 to 1024 (default: all cores)")
+    command->add_option("--threads", flags->threads, spec.threads_help)
         ->check(CLI::NonNegativeNumber);
   }
   if (spec.quiet) command->add_flag("--quiet", flags->quiet, "Print nothing on success");

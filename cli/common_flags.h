@@ -32,9 +32,11 @@ struct CommonFlagsSpec {
   std::string config_help = "JSON config";  // empty: no --config
   bool config_required = false;
   bool set = true;                         // --set key.path=value, repeatable
+  std::string set_help = "Override: key.path=value (JSON value), repeatable";
   std::string out_help = "Output folder";  // empty: no --out
   bool out_required = true;
   bool threads = true;
+  std::string threads_help = "Worker threads, 1 to 1024 (default: all cores)";
   bool quiet = true;
 };
 

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
+#include "cli/common_flags.h"
 #include "cli/compose_command.h"
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
@@ -357,11 +358,8 @@ void AddEvalCommand(CLI::App& app, const std::vector<std::string>& argv) {
   cmd->add_option("--models-info", args->models_info,
                   "BOP models_info.json with the object's symmetries (units of the model file); "
                   "default: models_info.json beside --model when there is one");
-  cmd->add_option("--config", args->common.config_file, "JSON config: sections track, eval");
-  cmd->add_option("--set", args->common.sets, "Override: key.path=value (JSON value), repeatable")
-      ->take_all();
-  cmd->add_option("--out", args->common.out_dir, "Output folder")->required();
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "JSON config: sections track, eval", .threads = false});
   cmd->callback([args, argv] { RunEval(*args, argv); });
 }
 

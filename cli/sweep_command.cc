@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
+#include "cli/common_flags.h"
 #include "cli/compose_command.h"
 #include "cli/full_executable.h"
 #include "core/error.h"
@@ -159,21 +160,20 @@ void AddSweepCommand(CLI::App& app, const std::vector<std::string>& argv) {
   CLI::App* cmd = app.add_subcommand(
       "sweep", "Parameter sweeps of run, study, compose or track, locally or on Slurm");
   cmd->add_option("--spec", args->spec, "Sweep spec (configs/sweeps/*.json)");
-  cmd->add_option("--out", args->common.out_dir,
-                  "Sweep folder (running again continues the sweep)");
+  AddCommonFlags(
+      cmd, &args->common,
+      {.config_help = "",
+       .set_help = "Override of every cell's base config: key.path=value, repeatable",
+       .out_help = "Sweep folder (running again continues the sweep)",
+       .out_required = false,
+       .threads_help =
+           "Threads of all cells together (default: all cores); each job gets its share"});
   cmd->add_option("--jobs", args->jobs, "Cells at a time (local backend)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--backend", args->backend, "local or slurm");
   cmd->add_flag("--dry-run", args->dry_run,
                 "Print the cells and write the plan (and the Slurm script) only");
-  cmd->add_option("--set", args->common.sets,
-                  "Override of every cell's base config: key.path=value, repeatable")
-      ->take_all();
-  cmd->add_option("--threads", args->common.threads,
-                  "Threads of all cells together (default: all cores); each job gets its share")
-      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--slurm-bin", args->slurm_bin, "Folder of sbatch/scontrol (default: PATH)");
-  cmd->add_flag("--quiet", args->common.quiet, "Print nothing on success");
 
   CLI::App* status = cmd->add_subcommand("status", "Done, failed and missing cells of a sweep");
   status->add_option("dir", args->dir, "Sweep folder")->required();
