@@ -34,12 +34,17 @@ std::vector<Eigen::Vector3f> Observe(const ProxyModel& model, const Rigid3& came
   return points;
 }
 
+// The proxy turned obliquely 1.1 m ahead of the camera.
+Rigid3 ObliquePose() {
+  return Rigid3(
+      Eigen::Quaterniond(Eigen::AngleAxisd(2.3, Eigen::Vector3d(0.2, -1, 0.3).normalized())),
+      Eigen::Vector3d(0.05, -0.02, 1.1));
+}
+
 TEST(PointToPlaneIcpTest, RecoversAKnownPose) {
   const test_take::SimTake take;
   const ProxyModel model(take.model(), ProxyModelOptions(), "soldier");
-  const Rigid3 truth(
-      Eigen::Quaterniond(Eigen::AngleAxisd(2.3, Eigen::Vector3d(0.2, -1, 0.3).normalized())),
-      Eigen::Vector3d(0.05, -0.02, 1.1));
+  const Rigid3 truth = ObliquePose();
   // Start 1 cm and 6 deg off (about the model's centre).
   const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.1, Eigen::Vector3d(1, 1, 0).normalized()));
   const Eigen::Vector3d c = model.center().cast<double>();
@@ -75,9 +80,7 @@ TEST(PointToPlaneIcpTest, RecoversAKnownPose) {
 TEST(PointToPlaneIcpTest, TukeyLetsADisplacedPatchGo) {
   const test_take::SimTake take;
   const ProxyModel model(take.model(), ProxyModelOptions(), "soldier");
-  const Rigid3 truth(
-      Eigen::Quaterniond(Eigen::AngleAxisd(2.3, Eigen::Vector3d(0.2, -1, 0.3).normalized())),
-      Eigen::Vector3d(0.05, -0.02, 1.1));
+  const Rigid3 truth = ObliquePose();
   auto points = Observe(model, truth, 0.0, 0, 4);
   const Eigen::Vector3f center = (truth.rotation * model.center().cast<double>() +
                                   truth.translation).cast<float>();
