@@ -24,6 +24,7 @@ void IcpOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".shrink_iterations", std::to_string(shrink_iterations), ">= 0");
   }
   RequirePositive(huber, prefix + ".huber", "m");
+  RequireNonNegative(tukey, prefix + ".tukey", "m");
   RequireNonNegative(min_rotation, prefix + ".min_rotation", "rad");
   RequireNonNegative(min_translation, prefix + ".min_translation", "m");
   RequirePositive(inlier_distance, prefix + ".inlier_distance", "m");
@@ -54,6 +55,7 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
   const auto& model_normals = model.normals();
   const float huber = static_cast<float>(options.huber);
   const float extra = static_cast<float>(extra_distance);
+  const float tukey = static_cast<float>(options.tukey);
   scored = std::min(scored, points.size());
   const bool colour = !sample_matches.empty();
   const uint8_t* matches = sample_matches.data();
@@ -75,7 +77,14 @@ IcpResult AlignPointToPlane(const ProxyModel& model, std::span<const Eigen::Vect
       const float max_distance = i < scored ? limit : std::min(limit, extra);
       if (d.squaredNorm() > max_distance * max_distance) continue;
       const float residual = n.dot(d);
-      equations.Add(s, n, residual);
+      if (tukey > 0) {
+        const float z = points[i].z();
+        const float c = tukey * z * z;
+        const float u = residual / c;
+        if (u * u < 1) equations.AddWeighted(s, n, residual, (1 - u * u) * (1 - u * u));
+      } else {
+        equations.Add(s, n, residual);
+      }
     }
     result.iterations = k + 1;
     if (equations.used() < 6) break;

@@ -25,6 +25,15 @@ struct IcpOptions {
   int shrink_iterations = 4;
   // Huber threshold on the point-to-plane residual [m] (about the Kinect's axial noise at 1 m).
   double huber = 0.003;
+  // Tukey's biweight instead of Huber's weight when > 0: a residual r of a point at depth z [m]
+  // weighs (1 - (r / c)^2)^2 within c = tukey * z^2 [m] and nothing beyond (Beaton and Tukey
+  // 1974). Huber's weight keeps a linear pull from every residual beyond its threshold; on a
+  // structured-light frame a patch of a face displaced by a correlated disparity error (a few mm,
+  // the size of a correlation window; docs/tracker.md, "Structured-light frames") pulls the face
+  // with all its points, the redescending biweight lets it go. c grows as z^2 because the
+  // disparity error's depth scale does (z^2 / (f b) per pixel of disparity; Khoshelham and Elberink
+  // 2012). 0: Huber.
+  double tukey = 0.0;
   // Converged when an update rotates less than this [rad] and moves less than this [m] (after the
   // distance has shrunk).
   double min_rotation = 2e-4;
@@ -49,6 +58,7 @@ struct IcpOptions {
     v("end_distance", end_distance);
     v("shrink_iterations", shrink_iterations);
     v("huber", huber);
+    v("tukey", tukey);
     v("min_rotation", min_rotation);
     v("min_translation", min_translation);
     v("inlier_distance", inlier_distance);

@@ -11,6 +11,21 @@
 
 namespace mmh::track {
 
+namespace {
+
+// Whether the depths `span` px before and after pixel i along a line (`stride` 1: the row,
+// `width`: the column; `before`/`after`: the neighbours lie in the image) exist and the pixel's
+// depth lies within `tolerance` [raw units] of their mean (SegmentationOptions::window_span).
+bool FlatAcross(const uint16_t* depth, size_t i, size_t offset, bool inside, float tolerance) {
+  if (!inside) return false;
+  const uint16_t a = depth[i - offset], b = depth[i + offset];
+  if (a == 0 || b == 0) return false;
+  return std::abs(static_cast<float>(a) + static_cast<float>(b) - 2.0f * depth[i]) <=
+         2.0f * tolerance;
+}
+
+}  // namespace
+
 void SegmentationOptions::Validate(const std::string& prefix) const {
   if (pixel_step < 1 || pixel_step > 16) {
     ThrowBadValue(prefix + ".pixel_step", std::to_string(pixel_step), "an integer in [1, 16]");
@@ -49,6 +64,10 @@ void SegmentationOptions::Validate(const std::string& prefix) const {
   }
   RequirePositive(window_margin, prefix + ".window_margin", "m");
   RequireNonNegative(max_depth_jump, prefix + ".max_depth_jump", "m");
+  if (window_span < 0 || window_span > 32) {
+    ThrowBadValue(prefix + ".window_span", std::to_string(window_span), "an integer in [0, 32]");
+  }
+  RequirePositive(window_tolerance, prefix + ".window_tolerance", "m");
   if (min_component_pixels < 1) {
     ThrowBadValue(prefix + ".min_component_pixels", std::to_string(min_component_pixels), ">= 1");
   }
@@ -93,6 +112,7 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
   out->skin_points.clear();
   out->component_sizes.clear();
   out->foreground_pixels = out->skin_pixels = out->dropped_pixels = 0;
+  out->window_dropped_pixels = 0;
   // The region examined: the play volume's image, within the window when one is given.
   ImageRect region = roi_;
   if (window) {
@@ -183,6 +203,8 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
   const float inverse_fx = static_cast<float>(1 / intrinsics_.fx);
   const float inverse_fy = static_cast<float>(1 / intrinsics_.fy);
   const float cx = static_cast<float>(intrinsics_.cx), cy = static_cast<float>(intrinsics_.cy);
+  const int span = options_.window_span;
+  const float window_tolerance = static_cast<float>(options_.window_tolerance);
   for (int my = 0; my < mh; ++my) {
     const int y = region.y0 + my * step;
     for (int mx = 0; mx < mw; ++mx) {
@@ -191,7 +213,18 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
       const int r = rank[labels[static_cast<size_t>(my) * mw + mx]];
       if (r < 0) continue;
       const int x = region.x0 + mx * step;
-      const float z = frame.depth[static_cast<size_t>(y) * width + x] * scale;
+      const size_t pixel = static_cast<size_t>(y) * width + x;
+      const float z = frame.depth[pixel] * scale;
+      if (m == 1 && span > 0) {
+        const float tolerance = window_tolerance * z * z / scale;
+        if (!FlatAcross(frame.depth.data(), pixel, span, x >= span && x + span < width,
+                        tolerance) ||
+            !FlatAcross(frame.depth.data(), pixel, static_cast<size_t>(span) * width,
+                        y >= span && y + span < height, tolerance)) {
+          ++out->window_dropped_pixels;
+          continue;
+        }
+      }
       const Eigen::Vector3f p((x - cx) * inverse_fx * z, (y - cy) * inverse_fy * z, z);
       if (m == 2) {
         out->skin_points.push_back(p);

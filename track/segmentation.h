@@ -50,6 +50,18 @@ struct SegmentationOptions {
   // While tracking, only the predicted proxy's image is segmented: its bounding sphere grown by
   // window_margin [m] (more than a frame's motion after the prediction).
   double window_margin = 0.03;
+  // Structured-light frames (docs/tracker.md, "Structured-light frames"): a block-matching
+  // sensor's depth at a pixel is the disparity of the whole correlation window around it (9 x 9
+  // px on the Kinect v1; Konolige 2010, Khoshelham and Elberink 2012), so where that window
+  // straddles a depth edge or a crease of the proxy the match blends the surfaces' disparities:
+  // the proxy's corners come out rounded and its small faces tilted by a correlated error that no
+  // per-point robust weight can tell from the surface. With window_span > 0 a proxy candidate is
+  // kept only where the depths window_span px to either side (along the row and the column) exist
+  // and the pixel's depth lies within window_tolerance * z^2 [m, z in m] of the line through them
+  // (a plane across the window; the tolerance grows as the disparity error's depth scale, z^2).
+  // 0: every candidate is kept (the statistical sensor draws its noise per pixel).
+  int window_span = 0;
+  double window_tolerance = 0.004;
 
   template <class V>
   void VisitFields(V& v) {
@@ -70,6 +82,8 @@ struct SegmentationOptions {
     v("min_component_pixels", min_component_pixels);
     v("max_depth_jump", max_depth_jump);
     v("window_margin", window_margin);
+    v("window_span", window_span);
+    v("window_tolerance", window_tolerance);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -92,6 +106,8 @@ struct Segmentation {
   int foreground_pixels = 0;  // in the play volume and before the background
   int skin_pixels = 0;
   int dropped_pixels = 0;  // in components under min_component_pixels
+  // Proxy candidates of kept components left out by SegmentationOptions::window_span.
+  int window_dropped_pixels = 0;
   ImageRect roi;           // the play volume's image
 };
 

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <numbers>
+#include <string>
 
 #include "core/error.h"
 #include "track/segmentation.h"
@@ -31,7 +32,7 @@ RgbdFrame TwoBlocks() {
   return frame;
 }
 
-Segmentation SegmentTwoBlocks(double max_depth_jump) {
+Segmentation SegmentTwoBlocks(double max_depth_jump, int window_span = 0) {
   TrackSetup setup;
   setup.play_area_width = setup.play_area_depth = 1.0;
   setup.like_box_length = 0;
@@ -39,6 +40,7 @@ Segmentation SegmentTwoBlocks(double max_depth_jump) {
   options.skin = false;
   options.background = false;
   options.max_depth_jump = max_depth_jump;
+  options.window_span = window_span;
   Segmenter segmenter(options, setup);
   // The table's z axis points at the camera: a half turn about x, its origin 1 m ahead.
   const Rigid3 camera_T_table(
@@ -72,9 +74,43 @@ TEST(SegmentationTest, DepthLimitSeparatesBlocksAndDropsTheirOutlines) {
   }
 }
 
+// SegmentationOptions::window_span: a point is kept only where the depths window_span px to
+// either side along its row and column exist and lie on a line with it. The blocks' faces are
+// flat and every step is 10 cm, so with span 2 exactly the pixels at least 2 px inside their own
+// block's outline stay: 16 x 36 of each block.
+TEST(SegmentationTest, WindowSpanKeepsPointsWhoseWindowIsFlat) {
+  const Segmentation plain = SegmentTwoBlocks(0.0);
+  EXPECT_EQ(plain.points.size(), 40u * 40u);
+  EXPECT_EQ(plain.window_dropped_pixels, 0);
+  const Segmentation s = SegmentTwoBlocks(0.0, 2);
+  EXPECT_EQ(s.points.size(), 2u * 16u * 36u);
+  EXPECT_EQ(s.window_dropped_pixels, 40 * 40 - 2 * 16 * 36);
+  for (const Eigen::Vector3f& p : s.points) {
+    // Column u = 40 + 100 x / z: inside 22..37 or 42..57.
+    const double u = 40 + 100 * p.x() / p.z();
+    EXPECT_TRUE((u > 21.5 && u < 37.5) || (u > 41.5 && u < 57.5)) << u;
+  }
+}
+
 TEST(SegmentationTest, NegativeDepthJumpIsRejected) {
   SegmentationOptions options;
   options.max_depth_jump = -0.01;
+  EXPECT_THROW(options.Validate("segmentation"), InputError);
+}
+
+TEST(SegmentationTest, BadWindowSpanIsRejectedByName) {
+  for (const int span : {-1, 33}) {
+    SegmentationOptions options;
+    options.window_span = span;
+    try {
+      options.Validate("segmentation");
+      ADD_FAILURE() << span;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("segmentation.window_span"), std::string::npos);
+    }
+  }
+  SegmentationOptions options;
+  options.window_tolerance = 0;
   EXPECT_THROW(options.Validate("segmentation"), InputError);
 }
 

@@ -29,7 +29,10 @@ class NormalEquations {
 
   void Add(const Eigen::Vector3f& s, const Eigen::Vector3f& n, float residual) {
     const float a = std::abs(residual);
-    const float w = a <= huber_ ? 1.0f : huber_ / a;
+    AddWeighted(s, n, residual, a <= huber_ ? 1.0f : huber_ / a);
+  }
+  // With the weight w given (another robust kernel's).
+  void AddWeighted(const Eigen::Vector3f& s, const Eigen::Vector3f& n, float residual, float w) {
     Eigen::Matrix<float, 6, 1> j;
     j.head<3>() = s.cross(n);
     j.tail<3>() = n;
