@@ -735,6 +735,19 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
        {{"b/baseline.json",
          R"({"root": ".", "scenarios": [{"name": "a", "config": "c.json", "config_hash": 7,)"
          R"( "metrics": {}}]})"}}},
+      // ---- sweep (spec, and the plan of an earlier sweep) --------------------------------------
+      {"sweep: spec with a repeated key",
+       "sweep --spec {D}/s.json --out {OUT} --dry-run",
+       {"s.json", "key 'command'", "twice"},
+       {{"s.json", "{\"command\": \"compose\", \"command\": \"run\", \"axes\": []}"}}},
+      {"sweep: spec cut short",
+       "sweep --spec {D}/s.json --out {OUT} --dry-run",
+       {"s.json:2:", "invalid JSON"},
+       {{"s.json", "{\"command\": \"compose\",\n \"axes\": [{\"key\": \"montage"}}},
+      {"sweep status: plan.json with a repeated key",
+       "sweep status {D}/sw",
+       {"plan.json", "key 'format'", "twice"},
+       {{"sw/plan.json", "{\"format\": \"mmh-sweep-plan-1\", \"format\": \"x\"}"}}},
       {"sensor-check: data missing", "sensor-check --data {D}/none --out {OUT}", {"none"}},
   };
 
