@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <vector>
 
 #include "core/error.h"
@@ -85,6 +86,9 @@ struct Header {
 Header ReadHeader(std::string_view bytes, const std::string& where) {
   Header header;
   bool have_format = false;
+  // Names seen (sets: a header of 10^5 properties must not take quadratic time).
+  std::set<std::string> element_names;
+  std::set<std::string> property_names;  // of the current element
   std::size_t pos = 0;
   for (int line_number = 1;; ++line_number) {
     const std::size_t end = bytes.find('\n', pos);
@@ -132,12 +136,11 @@ Header ReadHeader(std::string_view bytes, const std::string& where) {
                               .ptr == fields[2].data() + fields[2].size() &&
                       !fields[2].empty() && fields[2][0] != '-';
       if (!ok) ThrowBadValue(at, Quote(line), "'element NAME COUNT' with a count >= 0");
-      for (const Element& other : header.elements) {
-        if (other.name == fields[1]) {
-          ThrowBadValue(at, "a second element " + Quote(fields[1]), "each element once");
-        }
+      if (!element_names.insert(std::string(fields[1])).second) {
+        ThrowBadValue(at, "a second element " + Quote(fields[1]), "each element once");
       }
       header.elements.push_back({std::string(fields[1]), count, {}, line_number});
+      property_names.clear();
     } else if (keyword == "property") {
       if (header.elements.empty()) {
         ThrowBadValue(at, Quote(line), "a property after its element line");
@@ -165,10 +168,8 @@ Header ReadHeader(std::string_view bytes, const std::string& where) {
       } else {
         ThrowBadValue(at, Quote(line), "'property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME'");
       }
-      for (const Property& other : header.elements.back().properties) {
-        if (other.name == property.name) {
-          ThrowBadValue(at, "a second property " + Quote(property.name), "each property once");
-        }
+      if (!property_names.insert(property.name).second) {
+        ThrowBadValue(at, "a second property " + Quote(property.name), "each property once");
       }
       header.elements.back().properties.push_back(property);
     } else {
