@@ -4,15 +4,15 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <string>
 #include <system_error>
 #include <vector>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
-#include "core/internal/assimp_mesh_import.h"
-#include "core/plugin.h"
+#include "core/internal/obj_mesh_reader.h"
+#include "core/internal/ply_mesh_reader.h"
+#include "core/text_parsing.h"
 
 namespace mmh {
 namespace {
@@ -24,20 +24,6 @@ std::string LowerExtension(const fs::path& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return extension;
-}
-
-// A PLY's header must end with an "end_header" line: assimp 5.2's PLY reader loops for ever on a
-// header without one (a fuzz finding, fuzz/regressions/mesh/ply_without_end_header). Checked in
-// the first MiB, far more than any real header.
-void RequirePlyHeaderEnd(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string start(std::size_t{1} << 20, '\0');
-  in.read(start.data(), static_cast<std::streamsize>(start.size()));
-  start.resize(static_cast<std::size_t>(in.gcount()));
-  if (start.find("\nend_header") == std::string::npos) {
-    ThrowBadValue(path.string(), "a PLY header without an end_header line",
-                  "a valid ply mesh");
-  }
 }
 
 // Little-endian bytes whatever the host's byte order.
@@ -68,17 +54,11 @@ TriangleMesh LoadMesh(const fs::path& path, double scale) {
                   "an existing OBJ or PLY mesh file");
   }
 
-  if (extension == ".ply") RequirePlyHeaderEnd(path);
-
-  // assimp is loaded on the first mesh read (core/internal/assimp_mesh_import.h).
-  static const auto import_mesh = reinterpret_cast<internal::ImportMeshFunction>(
-      PluginSymbol(MMH_ASSIMP_MESH_IMPORT_PLUGIN, internal::kImportMeshSymbol));
-  TriangleMesh mesh;
-  std::string error;
-  if (!import_mesh(path.string(), &mesh, &error)) {
-    ThrowBadValue(where, "a file assimp cannot read (" + error + ")",
-                  "a valid " + extension.substr(1) + " mesh");
-  }
+  // Our own readers, not assimp's: Debian's assimp 5 aborted (ai_assert) or looped for ever on
+  // malformed PLY files that fuzzing found (fuzz/regressions/mesh/), and its allocations made
+  // every fuzzed input cost a whole-heap leak scan.
+  TriangleMesh mesh = extension == ".ply" ? internal::ReadPlyMesh(ReadBinaryFile(path), where)
+                                          : internal::ReadObjMesh(ReadTextFile(path), path);
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
     const Eigen::RowVector3f file_position = mesh.vertices.row(v);
     for (int c = 0; c < 3; ++c) {

@@ -9,14 +9,15 @@
 
 namespace mmh {
 
-// Reads an OBJ or PLY file (ASCII or binary; the extension decides, case-insensitive) through
-// assimp, triangulating polygons and ignoring points and lines. Vertex positions are multiplied by
-// `scale` (0.001 for the BOP datasets' millimetre models). Per-face colour, in order of preference:
-// the mean of the face's vertex colours, the diffuse colour of its material (OBJ `Kd`, taken as
-// sRGB as most tools do), kDefaultMeshColor. Vertices are kept as the file gives them (not welded).
-// A missing file, an unsupported extension, a parse failure (with assimp's message), a file without
-// triangles, non-finite vertices and a non-positive or non-finite scale are InputErrors naming the
-// file and the problem.
+// Reads an OBJ or PLY file (PLY in ASCII or binary; the extension decides, case-insensitive) with
+// mmh's own readers (core/internal/ply_mesh_reader.h, obj_mesh_reader.h), triangulating polygons
+// as fans and ignoring points and lines. Vertex positions are multiplied by `scale` (0.001 for the
+// BOP datasets' millimetre models). Per-face colour, in order of preference: the mean of the
+// face's vertex colours, the diffuse colour of its material (OBJ `Kd`, taken as sRGB as most tools
+// do), kDefaultMeshColor. Vertices are kept as the file gives them (not welded, unused ones kept).
+// A missing file, an unsupported extension, any malformed content (file and line or element, the
+// value, the expectation), a file without triangles, non-finite vertices and a non-positive or
+// non-finite scale are InputErrors.
 TriangleMesh LoadMesh(const std::filesystem::path& path, double scale = 1.0);
 
 // Writes a binary little-endian PLY (x y z nx ny nz as float, red green blue as uchar per vertex,

@@ -1,4 +1,5 @@
-// libFuzzer target: PLY and OBJ meshes (core/mesh_io.h, through Assimp). The first byte chooses
+// libFuzzer target: PLY and OBJ meshes (core/mesh_io.h: core/internal/ply_mesh_reader.h and
+// obj_mesh_reader.h). The first byte chooses
 // the format, the rest is the file.
 #include <cstddef>
 #include <cstdint>

@@ -33,18 +33,11 @@ for t in "${targets[@]}"; do
   mkdir -p "$work" "$findings"
   cp -n "$root/fuzz/corpus/$t/"* "$work/" 2>/dev/null || true
   echo "fuzz: $t for ${seconds} s"
-  # The mesh reader goes through assimp, whose allocations do not balance within one input: with
-  # leak detection libFuzzer scans the whole heap after nearly every input (about 1 input/s under
-  # ASan), and a scan that outlasts MMH_FUZZ_TIMEOUT is reported as a timeout of an input that
-  # takes milliseconds. Leaks of our own code are found by the other targets and the sanitized
-  # suites; assimp's are suppressed anyway (tools/sanitizer/lsan.supp).
-  extra=()
-  if [[ $t == mesh ]]; then extra=(-detect_leaks=0); fi
   # (The LeakSanitizer suppressions name third-party libraries only: tools/sanitizer/lsan.supp.)
   if ! UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       LSAN_OPTIONS="suppressions=$root/tools/sanitizer/lsan.supp:print_suppressions=0" \
       "$build_dir/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout="${MMH_FUZZ_TIMEOUT:-1}" -rss_limit_mb=2048 \
-      -max_len=65536 -print_final_stats=1 -artifact_prefix="$findings/" "${extra[@]}" "$work" \
+      -max_len=65536 -print_final_stats=1 -artifact_prefix="$findings/" "$work" \
       "$root/fuzz/regressions/$t" 2>"$build_dir/fuzz-$t.log"; then
     echo "fuzz: $t FOUND a problem: see $build_dir/fuzz-$t.log and $findings/" >&2
     status=1

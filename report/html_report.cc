@@ -10,6 +10,7 @@
 #include "core/annotation.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/text_parsing.h"
 #include "core/tum_io.h"
 #include "montage/match_cost.h"

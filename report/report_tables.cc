@@ -84,14 +84,6 @@ json TableJson(const std::string& title, const fs::path& path, const std::string
           {"columns", table.columns}, {"rows", table.rows}};
 }
 
-json ReadJsonFile(const fs::path& path) {
-  try {
-    return json::parse(ReadTextFile(path));
-  } catch (const json::parse_error& e) {
-    ThrowBadValue(path.string(), e.what(), "a JSON file");
-  }
-}
-
 std::string InlineSvg(const fs::path& path) {
   std::string svg = ReadTextFile(path);
   if (svg.rfind("<?xml", 0) == 0) svg = svg.substr(svg.find("?>") + 2);

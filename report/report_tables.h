@@ -33,9 +33,6 @@ double NumberAt(const CsvTable& table, std::size_t row, int column,
 nlohmann::json TableJson(const std::string& title, const std::filesystem::path& path,
                          const std::string& note = "");
 
-// A JSON file; InputError naming it when it is not JSON.
-nlohmann::json ReadJsonFile(const std::filesystem::path& path);
-
 // An SVG file as the page inlines it (an XML declaration dropped).
 std::string InlineSvg(const std::filesystem::path& path);
 

@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/text_parsing.h"
 #include "sweep/cell_store.h"
 #include "sweep/plots.h"
@@ -193,8 +194,12 @@ Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
       for (const auto& m : metrics) {
         if (!files.count(m.file)) {
           const fs::path path = CellDir(dir, cell.id) / "out" / m.file;
-          files[m.file] = fs::exists(path) ? json::parse(ReadTextFile(path), nullptr, false)
-                                           : json(json::value_t::discarded);
+          files[m.file] = json(json::value_t::discarded);
+          try {
+            if (fs::exists(path)) files[m.file] = ReadJsonFile(path);
+          } catch (const InputError&) {
+            // reported below as "missing or not JSON", with the cell
+          }
         }
         const json& root = files[m.file];
         const json* value = root.is_discarded() ? nullptr : FindKey(root, m.key);

@@ -11,6 +11,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/text_parsing.h"
 
 namespace mmh::sweep {
@@ -44,8 +45,15 @@ CellStatus ReadCellStatus(const fs::path& dir, const std::string& id) {
   const fs::path file = CellDir(dir, id) / "status.json";
   std::error_code ec;
   if (!fs::exists(file, ec)) return status;
-  const nlohmann::json j = nlohmann::json::parse(ReadTextFile(file), nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return status;  // never published half (rename)
+  // Never published half (rename): a status.json that does not parse was not written by mmh, and
+  // the cell counts as not run.
+  nlohmann::json j;
+  try {
+    j = ReadJsonFile(file);
+  } catch (const InputError&) {
+    return status;
+  }
+  if (!j.is_object()) return status;
   status.exit_code = j.value("exit_code", -1);
   status.signal = j.value("signal", 0);
   status.stderr_tail = j.value("stderr_tail", std::string());

@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/options.h"
 #include "core/text_parsing.h"
 #include "sweep/command_config.h"
@@ -344,6 +345,14 @@ Plan PlanFromJson(const json& j, const fs::path& file) {
   }
 }
 
+namespace {
+
+// plan.json: through ParseJsonText (syntax errors and repeated keys name the file and line) with
+// ReadTextFile's 1 GiB cap, not ReadJsonFile's 16 MiB: the plan of a sweep of 10^5 cells is larger.
+json ReadPlanJson(const fs::path& file) { return ParseJsonText(ReadTextFile(file), file.string()); }
+
+}  // namespace
+
 fs::path CellConfigPath(const fs::path& dir, const Cell& cell) {
   return dir / "configs" / (cell.id + ".json");
 }
@@ -352,8 +361,8 @@ void WritePlan(const fs::path& dir, const Plan& plan) {
   const fs::path plan_file = dir / "plan.json";
   const json now = PlanToJson(plan);
   if (fs::exists(plan_file)) {
-    const json earlier = json::parse(ReadTextFile(plan_file), nullptr, false);
-    if (earlier.is_discarded() || !earlier.is_object()) {
+    const json earlier = ReadPlanJson(plan_file);
+    if (!earlier.is_object()) {
       ThrowBadValue(plan_file.string(), "unreadable JSON", "the plan of an earlier mmh sweep");
     }
     json a = {{"spec", earlier.value("spec", json())},
@@ -395,9 +404,7 @@ Plan ReadPlan(const fs::path& dir) {
   if (!fs::exists(file)) {
     ThrowBadValue(file.string(), "missing", "the folder of a sweep (mmh sweep --spec ... --out DIR)");
   }
-  const json j = json::parse(ReadTextFile(file), nullptr, false);
-  if (j.is_discarded()) ThrowBadValue(file.string(), "unreadable JSON", "a plan mmh sweep wrote");
-  return PlanFromJson(j, file);
+  return PlanFromJson(ReadPlanJson(file), file);
 }
 
 }  // namespace mmh::sweep

@@ -13,6 +13,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/json_text.h"
 #include "core/text_parsing.h"
 #include "sweep/cell_store.h"
 #include "sweep/local_backend.h"
@@ -89,8 +90,9 @@ json ReadManifest(const fs::path& dir) {
   if (!fs::exists(file)) {
     ThrowBadValue(file.string(), "missing", "the manifest of a Slurm sweep (mmh sweep --backend slurm)");
   }
-  const json j = json::parse(ReadTextFile(file), nullptr, false);
-  if (j.is_discarded() || !j.contains("tasks")) {
+  // As plan.json (sweep/plan.cc): ParseJsonText with ReadTextFile's 1 GiB cap.
+  const json j = ParseJsonText(ReadTextFile(file), file.string());
+  if (!j.contains("tasks")) {
     ThrowBadValue(file.string(), "unreadable", "the manifest mmh sweep wrote");
   }
   return j;
@@ -254,7 +256,12 @@ SlurmSubmission SubmitSlurm(const Plan& plan, const fs::path& dir,
     json history = json::array();
     const fs::path history_file = dir / "slurm" / "submissions.json";
     if (fs::exists(history_file)) {
-      history = json::parse(ReadTextFile(history_file), nullptr, false);
+      // Read after the jobs were submitted: a damaged history is started again rather than
+      // failing a submission that has happened.
+      try {
+        history = ReadJsonFile(history_file);
+      } catch (const InputError&) {
+      }
       if (!history.is_array()) history = json::array();
     }
     history.push_back({{"arrays", record}, {"aggregate_job_id", s.aggregate_job_id}});

@@ -671,6 +671,24 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
        "track --input {RGBD} --model {D}/m.obj --out {OUT}",
        {"m.obj"},
        {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"}}},
+      // A fuzz finding: Debian's assimp 5 aborted on this PLY (exit 134); mmh reads PLY itself.
+      {"export: model PLY with letters in its values",
+       "export --trajectory {T0} --model {D}/m.ply --out {D}/m.glb",
+       {"m.ply:10: vertex 0", "'0i'", "a number of type float"},
+       {{"m.ply",
+         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+         "0 0 0i 1.001 0 i1 2\n"}}},
+      {"export: model binary PLY cut short",
+       "export --trajectory {T0} --model {D}/m.ply --out {D}/m.glb",
+       {"m.ply:3: got element 'vertex' of 3 items", "16 bytes after the header"},
+       {{"m.ply",
+         "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+         "property float y\nproperty float z\nend_header\n0123456789ab0123"}}},
+      {"export: model OBJ face index out of range",
+       "export --trajectory {T0} --model {D}/m.obj --out {D}/m.glb",
+       {"m.obj:4: f, corner 3", "vertex index '7'", "from 1 to 3"},
+       {{"m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n"}}},
       {"track: unknown key",
        "track --input {RGBD} --model {RGBD}/model.ply --out {OUT} "
        "--set tracker.bogus=1",
@@ -717,6 +735,19 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
        {{"b/baseline.json",
          R"({"root": ".", "scenarios": [{"name": "a", "config": "c.json", "config_hash": 7,)"
          R"( "metrics": {}}]})"}}},
+      // ---- sweep (spec, and the plan of an earlier sweep) --------------------------------------
+      {"sweep: spec with a repeated key",
+       "sweep --spec {D}/s.json --out {OUT} --dry-run",
+       {"s.json", "key 'command'", "twice"},
+       {{"s.json", "{\"command\": \"compose\", \"command\": \"run\", \"axes\": []}"}}},
+      {"sweep: spec cut short",
+       "sweep --spec {D}/s.json --out {OUT} --dry-run",
+       {"s.json:2:", "invalid JSON"},
+       {{"s.json", "{\"command\": \"compose\",\n \"axes\": [{\"key\": \"montage"}}},
+      {"sweep status: plan.json with a repeated key",
+       "sweep status {D}/sw",
+       {"plan.json", "key 'format'", "twice"},
+       {{"sw/plan.json", "{\"format\": \"mmh-sweep-plan-1\", \"format\": \"x\"}"}}},
       {"sensor-check: data missing", "sensor-check --data {D}/none --out {OUT}", {"none"}},
   };
 
