@@ -332,13 +332,13 @@ void Face(const std::vector<Segment>& segments, int k, double p, double heading_
   f.previous = f.position;
 }
 
-// Steps, hops, sway, head turns and tilt at time tau (progress p) into the segment.
+// Steps, hops, sway, head turns and tilt at time tau (progress p) into the segment; height, roll
+// and yaw follow their targets with a first-order lag (smooth_gain per frame).
 void Animate(const StoryObject& object, const Plan& plan, const Segment& seg, double tau,
-             double p, bool hesitating, double dt, Figure& f) {
+             double p, bool hesitating, double dt, double smooth_gain, Figure& f) {
   const Beat& beat = object.beats[seg.script_beat];
   const double intensity = seg.amplitude * beat.IntensityAt(p);
   const BeatStyleTarget target = ScriptTarget(seg.kind);
-  const double smooth_gain = 1 - std::exp(-dt / 0.04);
   double z_target = 0, roll_target = 0, yaw_target = 0;
   const bool moving = !hesitating;
   if (moving && (IsGait(seg.kind) || seg.kind == BeatKind::kJump)) {
@@ -479,6 +479,7 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
   Figure figure = StartFigure(object, segments);
   int current = -1;
   const double heading_gain = 1 - std::exp(-dt / options.heading_time_constant);
+  const double smooth_gain = 1 - std::exp(-dt / 0.04);
   for (int i = 0; i < frames; ++i) {
     const double t = i * dt;
     int k = current < 0 ? 0 : current;
@@ -494,7 +495,7 @@ Generated Generate(const StoryObject& object, const Plan& plan, int frames,
     const double p = seg.Progress(tau);
     Place(seg, p, figure);
     Face(segments, k, p, heading_gain, figure);
-    Animate(object, plan, seg, tau, p, seg.Hesitating(tau), dt, figure);
+    Animate(object, plan, seg, tau, p, seg.Hesitating(tau), dt, smooth_gain, figure);
     out.table_T_proxy.timestamps.push_back(t);
     out.table_T_proxy.poses.push_back(HeldPose(figure, plan, options, t));
     out.script_beat.push_back(seg.script_beat);
