@@ -6,17 +6,14 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "cli/command_registry.h"
+#include "cli/common_flags.h"
 #include "cli/provenance.h"
-#include "core/annotation.h"
-#include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
-#include "core/rgbd_folder.h"
-#include "core/tum_io.h"
 #include "montage/compose.h"
+#include "montage/compose_folder.h"
 #include "montage/layered.h"
 #include "report/trajectory_glb.h"
 
@@ -42,9 +39,10 @@ struct ComposeArgs {
 // The name of the first object (its glTF nodes are "proxy montage", ...; report/).
 constexpr char kFirstObject[] = "proxy";
 
-// The objects of the montage: the first from --takes / --annotations, one per --layer-takes. Their
-// files are checked and read here (InputError naming the flag or the file).
-std::vector<montage::LayeredObject> ReadObjects(const ComposeArgs& args) {
+// The objects of the montage: the first from --takes / --annotations, one per --layer-takes. The
+// flags are checked here (InputError naming the flag); the files are read by
+// montage::ReadComposeObject (InputError naming the file).
+std::vector<montage::ComposeObjectInput> ReadObjects(const ComposeArgs& args) {
   auto check_pair = [](const std::string& flag, const std::vector<std::string>& takes,
                        const std::vector<std::string>& annotations) {
     if (takes.size() != annotations.size()) {
@@ -66,50 +64,80 @@ std::vector<montage::LayeredObject> ReadObjects(const ComposeArgs& args) {
                     "none or one per layered object (" + std::to_string(layers) + ")");
     }
   }
-  std::vector<montage::LayeredObject> objects(1 + layers);
-  for (std::size_t i = 0; i <= layers; ++i) {
-    montage::LayeredObject& object = objects[i];
-    const auto& take_files = i == 0 ? args.takes : args.layer_takes[i - 1];
-    const auto& annotation_files = i == 0 ? args.annotations : args.layer_annotations[i - 1];
-    if (i > 0) {
-      check_pair("--layer-annotations (object " + std::to_string(i + 1) + ")", take_files,
-                 annotation_files);
-    }
-    object.name = i == 0 ? kFirstObject
-                  : args.layer_names.empty() ? "object_" + std::to_string(i + 1)
-                                             : args.layer_names[i - 1];
+  std::vector<montage::ComposeObjectInput> objects;
+  objects.push_back(montage::ReadComposeObject(kFirstObject, args.takes, args.annotations));
+  for (std::size_t i = 1; i <= layers; ++i) {
+    check_pair("--layer-annotations (object " + std::to_string(i + 1) + ")",
+               args.layer_takes[i - 1], args.layer_annotations[i - 1]);
+    const std::string name =
+        args.layer_names.empty() ? "object_" + std::to_string(i + 1) : args.layer_names[i - 1];
     // The name is a folder (layers/NAME) and a glTF node's prefix.
-    const bool plain = !object.name.empty() &&
-        std::all_of(object.name.begin(), object.name.end(), [](unsigned char c) {
-          return std::isalnum(c) || c == '_' || c == '-';
-        });
-    if (i > 0 && (!plain || object.name == kFirstObject ||
-                  std::any_of(objects.begin(), objects.begin() + i,
-                              [&](const auto& o) { return o.name == object.name; }))) {
-      ThrowBadValue("--layer-names", "'" + object.name + "'",
+    const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+      return std::isalnum(c) || c == '_' || c == '-';
+    });
+    if (!plain || name == kFirstObject ||
+        std::any_of(objects.begin(), objects.end(),
+                    [&](const auto& o) { return o.object.name == name; })) {
+      ThrowBadValue("--layer-names", "'" + name + "'",
                     "a unique name of letters, digits, '_' or '-' other than 'proxy'");
     }
-    for (const auto& path : take_files) {
-      object.takes.push_back(ReadTum(path));
-      object.names.push_back(path);
-    }
-    for (const auto& path : annotation_files) {
-      object.annotations.push_back(ReadAnnotationCsv(path));
-      object.names.push_back(path);
-    }
+    objects.push_back(
+        montage::ReadComposeObject(name, args.layer_takes[i - 1], args.layer_annotations[i - 1]));
   }
   return objects;
 }
 
-// The timeline, segments and summary of one object's montage into `dir`.
-void WriteMontageFiles(const std::filesystem::path& dir, const montage::Montage& montage,
-                       const nlohmann::json& summary, const std::string& what) {
-  WriteTum(dir / "montage.tum", montage.trajectory,
-           "MotionMontage montage of " + what + " (mmh compose)\n" +
-               "timestamp tx ty tz qx qy qz qw");
-  WriteFileAtomically(dir / "segments.csv", montage::SegmentsToCsv(montage.segments));
-  WriteFileAtomically(dir / "timeline.csv", montage::TimelineToCsv(montage));
-  WriteFileAtomically(dir / "summary.json", summary.dump(2) + "\n");
+// montage.glb: every object's montage, its takes warped and as recorded, the first object's
+// markers (report/trajectory_glb.h).
+std::string MontageGlb(const ComposeArgs& args,
+                       const std::vector<montage::ComposeObjectInput>& objects,
+                       const std::vector<montage::Montage>& montages, int reference_take) {
+  std::vector<report::MontageObject> scene(objects.size());
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const std::string& model = i == 0                      ? args.model
+                               : args.layer_models.empty() ? std::string()
+                                                           : args.layer_models[i - 1];
+    scene[i].name = objects[i].object.name;
+    scene[i].mesh = model.empty() ? report::OrientedStandIn()
+                                  : report::LoadExportMesh(model, args.model_scale);
+    scene[i].montage = montages[i].trajectory;
+    scene[i].takes = objects[i].object.takes;
+    scene[i].warps = montages[i].warps;
+    scene[i].reference_take = reference_take;
+    if (i == 0) scene[i].marker_frames = args.markers;
+  }
+  return report::EncodeGlb(report::MontageScene(scene));
+}
+
+void PrintCompose(const std::filesystem::path& out,
+                  const std::vector<montage::ComposeObjectInput>& objects,
+                  const montage::ComposeFolderResult& result) {
+  const montage::Montage& montage = result.montages.front();
+  const auto& s = montage.summary;
+  std::cout << "montage: " << s.montage_frames << " frames from " << s.takes << " takes, "
+            << montage.segments.size() << " segments (shortest " << s.shortest_segment_reference
+            << " reference frames)\n"
+            << "cost: total " << s.total_cost << " = data " << s.data_cost << " + smoothness "
+            << s.smoothness_cost << "; without the segment constraint " << s.unconstrained_cost
+            << " (+" << s.constraint_increase_percent << " %, " << s.unconstrained_short_segments
+            << " short segments avoided)\n"
+            << "time: " << s.seconds.total * 1e3 << " ms (dtw " << s.seconds.dtw * 1e3
+            << ", smoothness " << s.seconds.smoothness * 1e3 << ", labelling "
+            << s.seconds.labelling * 1e3 << ")\n";
+  for (const auto& w : s.warnings) std::cout << "warning: " << w << '\n';
+  for (std::size_t i = 1; i < objects.size(); ++i) {
+    const std::string& name = objects[i].object.name;
+    const auto& l = result.montages[i].summary;
+    std::cout << "layer " << name << ": " << l.montage_frames << " frames from " << l.takes
+              << " takes, " << result.montages[i].segments.size() << " segments, total cost "
+              << l.total_cost << " (layers/" << name << "/)\n";
+    for (const auto& w : l.warnings) std::cout << "warning: " << name << ": " << w << '\n';
+  }
+  std::cout << "written: " << out.string() << "/{";
+  for (std::size_t i = 0; i < result.written.size(); ++i) {
+    std::cout << (i ? ", " : "") << result.written[i];
+  }
+  std::cout << "}\n";
 }
 
 void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
@@ -120,115 +148,20 @@ void RunCompose(const ComposeArgs& args, const std::vector<std::string>& argv) {
   const auto threads = LimitThreads(args.common.threads);
   StartGitCommitLookup();  // for run.json, while the takes are read and composed
 
-  // Everything is read and computed before anything is written: bad input leaves no output.
-  const std::vector<montage::LayeredObject> objects = ReadObjects(args);
-  // One object: montage::Compose; more: the first time-warped, the later ones not (layered.h).
-  const std::vector<montage::Montage> montages = montage::ComposeLayered(objects, options);
-  const montage::Montage& montage = montages.front();
-  const std::vector<Trajectory>& takes = objects.front().takes;
-
-  // Spatial markers on the montage's timeline (at least 60 frames apart, paper).
-  Trajectory marker_poses;
-  if (!args.markers.empty()) {
-    montage::SpatialMarkers markers;
-    for (int frame : args.markers) markers.Add("montage", frame);
-    const auto poses = markers.Poses({{"montage", montage.trajectory}});
-    const auto all = markers.All();
-    for (std::size_t i = 0; i < all.size(); ++i) {
-      marker_poses.timestamps.push_back(montage.trajectory.timestamps[all[i].frame]);
-      marker_poses.poses.push_back(poses[i]);
-    }
-  }
-
-  // montage.glb: the montage, every take warped and as recorded, the markers (report/).
-  std::string glb;
+  const std::vector<montage::ComposeObjectInput> objects = ReadObjects(args);
+  montage::ComposeFolderOptions folder;
+  folder.marker_frames = args.markers;
+  folder.provenance = [&](const nlohmann::json& resolved, const nlohmann::json& timings) {
+    return Provenance(argv, resolved, args.common.threads, timings);
+  };
   if (!args.no_glb) {
-    std::vector<report::MontageObject> scene(objects.size());
-    for (std::size_t i = 0; i < objects.size(); ++i) {
-      const std::string& model = i == 0 ? args.model
-                                 : args.layer_models.empty() ? std::string()
-                                                             : args.layer_models[i - 1];
-      scene[i].name = objects[i].name;
-      scene[i].mesh = model.empty() ? report::OrientedStandIn()
-                                    : report::LoadExportMesh(model, args.model_scale);
-      scene[i].montage = montages[i].trajectory;
-      scene[i].takes = objects[i].takes;
-      scene[i].warps = montages[i].warps;
-      scene[i].reference_take = options.reference_take;
-      if (i == 0) scene[i].marker_frames = args.markers;
-    }
-    glb = report::EncodeGlb(report::MontageScene(scene));
+    folder.glb = [&](const std::vector<montage::Montage>& montages) {
+      return MontageGlb(args, objects, montages, options.reference_take);
+    };
   }
-
-  nlohmann::json resolved;
-  resolved["montage"] = ToJson(options);
-  nlohmann::json summary = montage::SummaryToJson(montage.summary, montage.segments);
-  summary["take_files"] = args.takes;
-  summary["annotation_files"] = args.annotations;
-  std::vector<nlohmann::json> layer_summaries;
-  for (std::size_t i = 1; i < objects.size(); ++i) {
-    nlohmann::json layer = montage::SummaryToJson(montages[i].summary, montages[i].segments);
-    layer.erase("seconds");
-    layer["name"] = objects[i].name;
-    layer["take_files"] = args.layer_takes[i - 1];
-    layer["annotation_files"] = args.layer_annotations[i - 1];
-    layer_summaries.push_back(layer);
-    summary["layers"].push_back({{"name", objects[i].name}, {"folder", "layers/" + objects[i].name}});
-  }
-
-  // Timings differ on every run: they go to run.json only, so summary.json is a pure function of
-  // the inputs and config (DESIGN.md, "Determinism").
-  const nlohmann::json timings = summary["seconds"];
-  summary.erase("seconds");
-
-  // The folder is complete or absent: every file goes into a staging folder beside it, which is
-  // renamed into place at the end (a failure or a kill leaves no partial folder under --out).
-  const std::filesystem::path out = args.common.out_dir;
-  StagedFolder staged(out);
-  const std::filesystem::path& dir = staged.staging();
-  WriteMontageFiles(dir, montage, summary, std::to_string(takes.size()) + " takes");
-  for (std::size_t i = 1; i < objects.size(); ++i) {
-    const std::filesystem::path layer = dir / "layers" / objects[i].name;
-    EnsureDirectory(layer);
-    WriteMontageFiles(layer, montages[i], layer_summaries[i - 1],
-                      objects[i].name + ": " + std::to_string(objects[i].takes.size()) +
-                          " takes, layered");
-  }
-  if (!marker_poses.empty()) {
-    WriteTum(dir / "markers.tum", marker_poses,
-             "spatial markers: montage poses at the marked frames");
-  }
-  if (!glb.empty()) WriteFileAtomically(dir / "montage.glb", glb);
-  WriteFileAtomically(dir / "config.resolved.json", resolved.dump(2) + "\n");
-  WriteFileAtomically(dir / "run.json",
-                      Provenance(argv, resolved, args.common.threads, timings).dump(2) + "\n");
-  staged.Commit();
-
-  if (!args.common.quiet) {
-    const auto& s = montage.summary;
-    std::cout << "montage: " << s.montage_frames << " frames from " << s.takes << " takes, "
-              << montage.segments.size() << " segments (shortest " << s.shortest_segment_reference
-              << " reference frames)\n"
-              << "cost: total " << s.total_cost << " = data " << s.data_cost << " + smoothness "
-              << s.smoothness_cost << "; without the segment constraint " << s.unconstrained_cost
-              << " (+" << s.constraint_increase_percent << " %, " << s.unconstrained_short_segments
-              << " short segments avoided)\n"
-              << "time: " << s.seconds.total * 1e3 << " ms (dtw " << s.seconds.dtw * 1e3
-              << ", smoothness " << s.seconds.smoothness * 1e3 << ", labelling "
-              << s.seconds.labelling * 1e3 << ")\n";
-    for (const auto& w : s.warnings) std::cout << "warning: " << w << '\n';
-    for (std::size_t i = 1; i < objects.size(); ++i) {
-      const auto& l = montages[i].summary;
-      std::cout << "layer " << objects[i].name << ": " << l.montage_frames << " frames from "
-                << l.takes << " takes, " << montages[i].segments.size() << " segments, total cost "
-                << l.total_cost << " (layers/" << objects[i].name << "/)\n";
-      for (const auto& w : l.warnings) std::cout << "warning: " << objects[i].name << ": " << w << '\n';
-    }
-    std::cout << "written: " << out.string() << "/{montage.tum, segments.csv, timeline.csv, "
-              << "summary.json, config.resolved.json, run.json"
-              << (marker_poses.empty() ? "" : ", markers.tum") << (glb.empty() ? "" : ", montage.glb")
-              << "}\n";
-  }
+  const montage::ComposeFolderResult result =
+      montage::ComposeToFolder(objects, options, args.common.out_dir, folder);
+  if (!args.common.quiet) PrintCompose(args.common.out_dir, objects, result);
 }
 
 }  // namespace

@@ -4,8 +4,6 @@
 #include <string>
 #include <vector>
 
-#include "cli/common_flags.h"  // CommonFlags, LoadConfig, LimitThreads (kept for includers)
-
 namespace CLI {
 class App;
 }

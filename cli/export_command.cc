@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
+#include "cli/common_flags.h"
 #include "core/error.h"
 #include "core/tum_io.h"
 #include "report/trajectory_glb.h"
@@ -16,8 +17,7 @@ struct ExportArgs {
   std::string model;
   double scale = 1.0;
   std::string frame = "table";
-  std::string out;
-  bool quiet = false;
+  CommonFlags common;  // --out (a .glb file) and --quiet
 };
 
 void RunExport(const ExportArgs& args) {
@@ -27,17 +27,17 @@ void RunExport(const ExportArgs& args) {
   } else if (args.frame != "table") {
     ThrowBadValue("--frame", args.frame, "table or camera");
   }
-  if (std::filesystem::path(args.out).extension() != ".glb") {
-    ThrowBadValue("--out", args.out, "a file name ending in .glb");
+  if (std::filesystem::path(args.common.out_dir).extension() != ".glb") {
+    ThrowBadValue("--out", args.common.out_dir, "a file name ending in .glb");
   }
   // Everything is read and checked before the file is written (atomically).
   const Trajectory trajectory = ReadTum(args.trajectory);
   options.name = std::filesystem::path(args.trajectory).stem().string();
   const TriangleMesh mesh =
       args.model.empty() ? report::OrientedStandIn() : report::LoadExportMesh(args.model, args.scale);
-  report::WriteGlb(args.out, report::TrajectoryScene(mesh, trajectory, options));
-  if (!args.quiet) {
-    std::cout << "written: " << args.out << " (" << trajectory.size() << " keyframes, "
+  report::WriteGlb(args.common.out_dir, report::TrajectoryScene(mesh, trajectory, options));
+  if (!args.common.quiet) {
+    std::cout << "written: " << args.common.out_dir << " (" << trajectory.size() << " keyframes, "
               << mesh.face_count() << " faces)\n";
   }
 }
@@ -52,8 +52,8 @@ void AddExportCommand(CLI::App& app, const std::vector<std::string>& /*argv*/) {
   cmd->add_option("--scale", args->scale, "Model scale (0.001 for millimetre models)");
   cmd->add_option("--frame", args->frame,
                   "Frame of the poses: table (z up, default) or camera (Kinect: y down, z forward)");
-  cmd->add_option("--out", args->out, "Output .glb file")->required();
-  cmd->add_flag("--quiet", args->quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "", .set = false, .out_help = "Output .glb file", .threads = false});
   cmd->callback([args] { RunExport(*args); });
 }
 

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "cli/command_registry.h"
+#include "cli/common_flags.h"
 #include "report/html_report.h"
 
 namespace mmh::cli {
@@ -12,7 +13,7 @@ namespace {
 struct ReportArgs {
   std::string dir;
   report::ReportOptions options;
-  bool quiet = false;
+  CommonFlags common;  // --quiet
 };
 
 void AddReportCommand(CLI::App& app, const std::vector<std::string>& /*argv*/) {
@@ -22,10 +23,11 @@ void AddReportCommand(CLI::App& app, const std::vector<std::string>& /*argv*/) {
   cmd->add_option("dir", args->dir, "Output folder of mmh compose, run or study")->required();
   cmd->add_option("--dtw-image-size", args->options.dtw_image_size,
                   "Largest side of each DTW matching-cost image [cells] (default 200)");
-  cmd->add_flag("--quiet", args->quiet, "Print nothing on success");
+  AddCommonFlags(cmd, &args->common,
+                 {.config_help = "", .set = false, .out_help = "", .threads = false});
   cmd->callback([args] {
     const report::ReportSummary summary = report::WriteReport(args->dir, args->options);
-    if (!args->quiet) {
+    if (!args->common.quiet) {
       std::cout << "report (" << report::FolderKindName(summary.kind) << "): "
                 << summary.file.string() << " (" << summary.bytes / 1024 << " KiB, "
                 << summary.seconds * 1e3 << " ms)\n";

@@ -13,7 +13,6 @@
 
 #include "cli/command_registry.h"
 #include "cli/common_flags.h"
-#include "cli/compose_command.h"
 #include "cli/full_executable.h"
 #include "core/error.h"
 #include "sweep/aggregate.h"

@@ -396,108 +396,124 @@ std::string ErrorModelEstimate::DefaultsSource(const std::string& origin) const 
   return out;
 }
 
-ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
-                                      const std::vector<ReadingObservation>& readings,
-                                      const ErrorModelOptions& prior, double gross_threshold_deg,
-                                      double gross_threshold_m) {
-  ErrorModelEstimate estimate;
-  estimate.options = prior;
-  const double gross_threshold_rad = gross_threshold_deg * kPi / 180.0;
+namespace {
 
-  // Pose errors: per type (0 rotation, 1 translation) the sum of squares over inlier frames, and
-  // over consecutive inlier pairs the lag-one products and the mean squares of the pair.
+// What the pose errors of the tracking observations add up to: per type (0 rotation,
+// 1 translation) the sum of squares over inlier frames, and over consecutive inlier pairs the
+// lag-one products and the mean squares of the pair; the episodes' runs; over flip frames the sums
+// of the error angle and distance, over spike frames the squares per type.
+struct PoseErrorSums {
   std::array<double, 2> squares = {0, 0}, lag_products = {0, 0}, lag_squares = {0, 0};
   Runs flip_runs, spike_runs, loss_runs;
-  // Flip frames: sums of the error angle and distance; spike frames: squares per type.
   double flip_angle_sum = 0, flip_distance_sum = 0;
   std::array<double, 2> spike_squares = {0, 0};
-  for (std::size_t i = 0; i < tracking.size(); ++i) {
-    const auto& obs = tracking[i];
-    const std::string name = "tracking observation " + std::to_string(i);
-    if (!obs.truth || !obs.tracked || !obs.status) throw InputError(name + ": missing data");
-    const std::size_t n = obs.truth->size();
-    if (obs.tracked->size() != n || obs.status->size() != n) {
-      throw InputError(name + ": truth, tracked and status lengths differ (" + std::to_string(n) +
-                       ", " + std::to_string(obs.tracked->size()) + ", " +
-                       std::to_string(obs.status->size()) + ")");
-    }
-    std::vector<std::array<double, 6>> errors(n);
-    std::vector<bool> lost(n), flip(n), spike(n), inlier(n), lost_or_flip(n);
-    std::vector<int> condition(n);
-    for (std::size_t t = 0; t < n; ++t) {
-      condition[t] =
-          ViewCondition(obs.truth->poses[t], obs.table_camera_position, prior.lying_tilt_deg);
-      ++estimate.condition_frames[condition[t]];
-      lost[t] = (*obs.status)[t] == track::TrackStatus::kLost;
-      if (lost[t]) continue;
-      errors[t] = PoseError(obs.truth->poses[t], obs.tracked->poses[t]);
-      const double angle = std::hypot(errors[t][0], errors[t][1], errors[t][2]);
-      const double distance = std::hypot(errors[t][3], errors[t][4], errors[t][5]);
-      const bool gross = angle > gross_threshold_rad || distance > gross_threshold_m;
-      flip[t] = gross && angle > kPi / 2;
-      spike[t] = gross && !flip[t];
-      inlier[t] = !gross;
-      if (flip[t]) {
-        flip_angle_sum += angle;
-        flip_distance_sum += distance;
-      }
-      if (spike[t]) {
-        for (int k = 0; k < 6; ++k) spike_squares[k / 3] += errors[t][k] * errors[t][k];
-      }
-      if (!inlier[t]) continue;
-      ++estimate.inlier_frames;
-      for (int k = 0; k < 6; ++k) squares[k / 3] += errors[t][k] * errors[t][k];
-    }
-    for (std::size_t t = 0; t + 1 < n; ++t) {
-      if (!inlier[t] || !inlier[t + 1]) continue;
-      for (int k = 0; k < 6; ++k) {
-        lag_products[k / 3] += errors[t][k] * errors[t + 1][k];
-        lag_squares[k / 3] +=
-            0.5 * (errors[t][k] * errors[t][k] + errors[t + 1][k] * errors[t + 1][k]);
-      }
-    }
-    estimate.frames += static_cast<std::int64_t>(n);
-    CountRuns(lost, std::vector<bool>(n, false), condition, &loss_runs);
-    for (std::size_t t = 0; t < n; ++t) lost_or_flip[t] = lost[t] || flip[t];
-    CountRuns(flip, lost, condition, &flip_runs);
-    CountRuns(spike, lost_or_flip, condition, &spike_runs);
+};
+
+struct GrossThresholds {
+  double rotation_rad = 0.0;
+  double translation_m = 0.0;
+};
+
+// One tracking observation's frames into `sums`: each frame classified as lost, a flip (a gross
+// error of more than a half turn), a spike (another gross error) or an inlier, by view condition.
+void AddTracking(const TrackingObservation& obs, std::size_t index, const ErrorModelOptions& prior,
+                 const GrossThresholds& gross_threshold, PoseErrorSums* sums,
+                 ErrorModelEstimate* estimate) {
+  const std::string name = "tracking observation " + std::to_string(index);
+  if (!obs.truth || !obs.tracked || !obs.status) throw InputError(name + ": missing data");
+  const std::size_t n = obs.truth->size();
+  if (obs.tracked->size() != n || obs.status->size() != n) {
+    throw InputError(name + ": truth, tracked and status lengths differ (" + std::to_string(n) +
+                     ", " + std::to_string(obs.tracked->size()) + ", " +
+                     std::to_string(obs.status->size()) + ")");
   }
-  estimate.lost_frames = loss_runs.Total(loss_runs.frames);
-  estimate.flip_frames = flip_runs.Total(flip_runs.frames);
-  estimate.spike_frames = spike_runs.Total(spike_runs.frames);
-  estimate.loss_episodes = static_cast<int>(loss_runs.Total(loss_runs.starts));
-  estimate.flip_episodes = static_cast<int>(flip_runs.Total(flip_runs.starts));
-  estimate.spike_episodes = static_cast<int>(spike_runs.Total(spike_runs.starts));
-  ErrorModelOptions& fit = estimate.options;
-  if (estimate.inlier_frames > 0) {
-    const double axes = 3.0 * static_cast<double>(estimate.inlier_frames);
-    fit.rotation_sd = std::sqrt(squares[0] / axes);
-    fit.translation_sd = std::sqrt(squares[1] / axes);
+  std::vector<std::array<double, 6>> errors(n);
+  std::vector<bool> lost(n), flip(n), spike(n), inlier(n), lost_or_flip(n);
+  std::vector<int> condition(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    condition[t] =
+        ViewCondition(obs.truth->poses[t], obs.table_camera_position, prior.lying_tilt_deg);
+    ++estimate->condition_frames[condition[t]];
+    lost[t] = (*obs.status)[t] == track::TrackStatus::kLost;
+    if (lost[t]) continue;
+    errors[t] = PoseError(obs.truth->poses[t], obs.tracked->poses[t]);
+    const double angle = std::hypot(errors[t][0], errors[t][1], errors[t][2]);
+    const double distance = std::hypot(errors[t][3], errors[t][4], errors[t][5]);
+    const bool gross =
+        angle > gross_threshold.rotation_rad || distance > gross_threshold.translation_m;
+    flip[t] = gross && angle > kPi / 2;
+    spike[t] = gross && !flip[t];
+    inlier[t] = !gross;
+    if (flip[t]) {
+      sums->flip_angle_sum += angle;
+      sums->flip_distance_sum += distance;
+    }
+    if (spike[t]) {
+      for (int k = 0; k < 6; ++k) sums->spike_squares[k / 3] += errors[t][k] * errors[t][k];
+    }
+    if (!inlier[t]) continue;
+    ++estimate->inlier_frames;
+    for (int k = 0; k < 6; ++k) sums->squares[k / 3] += errors[t][k] * errors[t][k];
   }
-  // Pooled over the six components, each type scaled by its variance.
+  for (std::size_t t = 0; t + 1 < n; ++t) {
+    if (!inlier[t] || !inlier[t + 1]) continue;
+    for (int k = 0; k < 6; ++k) {
+      sums->lag_products[k / 3] += errors[t][k] * errors[t + 1][k];
+      sums->lag_squares[k / 3] +=
+          0.5 * (errors[t][k] * errors[t][k] + errors[t + 1][k] * errors[t + 1][k]);
+    }
+  }
+  estimate->frames += static_cast<std::int64_t>(n);
+  CountRuns(lost, std::vector<bool>(n, false), condition, &sums->loss_runs);
+  for (std::size_t t = 0; t < n; ++t) lost_or_flip[t] = lost[t] || flip[t];
+  CountRuns(flip, lost, condition, &sums->flip_runs);
+  CountRuns(spike, lost_or_flip, condition, &sums->spike_runs);
+}
+
+// The pose error's parameters from the sums: inlier sds per axis, the lag-one correlation pooled
+// over the six components (each type scaled by its variance), the episodes' hazards per view
+// condition, and the flips' and spikes' sizes.
+void FitPoseErrors(const PoseErrorSums& sums, ErrorModelEstimate* estimate) {
+  estimate->lost_frames = sums.loss_runs.Total(sums.loss_runs.frames);
+  estimate->flip_frames = sums.flip_runs.Total(sums.flip_runs.frames);
+  estimate->spike_frames = sums.spike_runs.Total(sums.spike_runs.frames);
+  estimate->loss_episodes = static_cast<int>(sums.loss_runs.Total(sums.loss_runs.starts));
+  estimate->flip_episodes = static_cast<int>(sums.flip_runs.Total(sums.flip_runs.starts));
+  estimate->spike_episodes = static_cast<int>(sums.spike_runs.Total(sums.spike_runs.starts));
+  ErrorModelOptions& fit = estimate->options;
+  if (estimate->inlier_frames > 0) {
+    const double axes = 3.0 * static_cast<double>(estimate->inlier_frames);
+    fit.rotation_sd = std::sqrt(sums.squares[0] / axes);
+    fit.translation_sd = std::sqrt(sums.squares[1] / axes);
+  }
   double numerator = 0, denominator = 0;
   for (int type = 0; type < 2; ++type) {
     const double sd = type == 0 ? fit.rotation_sd : fit.translation_sd;
-    if (sd <= 0 || lag_squares[type] <= 0) continue;
-    numerator += lag_products[type] / (sd * sd);
-    denominator += lag_squares[type] / (sd * sd);
+    if (sd <= 0 || sums.lag_squares[type] <= 0) continue;
+    numerator += sums.lag_products[type] / (sd * sd);
+    denominator += sums.lag_squares[type] / (sd * sd);
   }
   if (denominator > 0) fit.correlation = std::clamp(numerator / denominator, 0.0, 0.999);
-  FitHazards(loss_runs, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, &fit.view);
-  FitHazards(flip_runs, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, &fit.view);
-  FitHazards(spike_runs, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames, &fit.view);
-  if (estimate.flip_frames > 0) {
-    const double frames = static_cast<double>(estimate.flip_frames);
-    fit.flip_rotation = flip_angle_sum / frames;
-    fit.flip_translation = flip_distance_sum / frames;
+  FitHazards(sums.loss_runs, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, &fit.view);
+  FitHazards(sums.flip_runs, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, &fit.view);
+  FitHazards(sums.spike_runs, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames,
+             &fit.view);
+  if (estimate->flip_frames > 0) {
+    const double frames = static_cast<double>(estimate->flip_frames);
+    fit.flip_rotation = sums.flip_angle_sum / frames;
+    fit.flip_translation = sums.flip_distance_sum / frames;
   }
-  if (estimate.spike_frames > 0) {
-    const double frames = static_cast<double>(estimate.spike_frames);
-    fit.spike_rotation_sd = std::sqrt(spike_squares[0] / (3 * frames));
-    fit.spike_translation_sd = std::sqrt(spike_squares[1] / (3 * frames));
+  if (estimate->spike_frames > 0) {
+    const double frames = static_cast<double>(estimate->spike_frames);
+    fit.spike_rotation_sd = std::sqrt(sums.spike_squares[0] / (3 * frames));
+    fit.spike_translation_sd = std::sqrt(sums.spike_squares[1] / (3 * frames));
   }
+}
 
-  // Slider readings over found frames.
+// The slider reading's error over the found frames: bias, sd, lag-one correlation (of the errors
+// less the bias) and the share of frames where the block was not found.
+void FitSlider(const std::vector<ReadingObservation>& readings, ErrorModelEstimate* estimate) {
+  ErrorModelOptions& fit = estimate->options;
   double sum = 0, sum_squares = 0, slider_lag_product = 0, slider_lag_squares = 0;
   std::int64_t found_frames = 0;
   for (std::size_t i = 0; i < readings.size(); ++i) {
@@ -510,10 +526,10 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
                        ", " + std::to_string(obs.read->size()) + ", " +
                        std::to_string(obs.found->size()) + ")");
     }
-    estimate.slider_frames += static_cast<std::int64_t>(n);
+    estimate->slider_frames += static_cast<std::int64_t>(n);
     for (std::size_t t = 0; t < n; ++t) {
       if (!(*obs.found)[t]) {
-        ++estimate.slider_missed;
+        ++estimate->slider_missed;
         continue;
       }
       const double e = obs.read->values[t] - obs.truth->values[t];
@@ -527,7 +543,7 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
     const double bias = sum / count;
     fit.slider_bias = bias;
     fit.slider_sd = std::sqrt(std::max(0.0, (sum_squares - count * bias * bias) / (count - 1)));
-    estimate.slider_rmse = std::sqrt(sum_squares / count);
+    estimate->slider_rmse = std::sqrt(sum_squares / count);
     for (const auto& obs : readings) {
       const std::size_t n = obs.truth->size();
       for (std::size_t t = 0; t + 1 < n; ++t) {
@@ -542,10 +558,27 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
       fit.slider_correlation = std::clamp(slider_lag_product / slider_lag_squares, 0.0, 0.999);
     }
   }
-  if (estimate.slider_frames > 0) {
-    fit.slider_miss_share =
-        static_cast<double>(estimate.slider_missed) / static_cast<double>(estimate.slider_frames);
+  if (estimate->slider_frames > 0) {
+    fit.slider_miss_share = static_cast<double>(estimate->slider_missed) /
+                            static_cast<double>(estimate->slider_frames);
   }
+}
+
+}  // namespace
+
+ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
+                                      const std::vector<ReadingObservation>& readings,
+                                      const ErrorModelOptions& prior, double gross_threshold_deg,
+                                      double gross_threshold_m) {
+  ErrorModelEstimate estimate;
+  estimate.options = prior;
+  const GrossThresholds gross{gross_threshold_deg * kPi / 180.0, gross_threshold_m};
+  PoseErrorSums sums;
+  for (std::size_t i = 0; i < tracking.size(); ++i) {
+    AddTracking(tracking[i], i, prior, gross, &sums, &estimate);
+  }
+  FitPoseErrors(sums, &estimate);
+  FitSlider(readings, &estimate);
   return estimate;
 }
 

@@ -148,30 +148,9 @@ void AppendU32(std::string* out, std::uint32_t value) {
   for (int i = 0; i < 4; ++i) out->push_back(static_cast<char>((value >> (8 * i)) & 0xFF));
 }
 
-}  // namespace
-
-Rigid3 GltfTFrame(TrajectoryFrame frame) {
-  if (frame == TrajectoryFrame::kTable) {
-    // (x, y, z) -> (x, z, -y): -90 deg about x.
-    return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX())),
-                  Eigen::Vector3d::Zero());
-  }
-  // (x, y, z) -> (x, -y, -z): 180 deg about x.
-  return Rigid3(Eigen::Quaterniond(0.0, 1.0, 0.0, 0.0), Eigen::Vector3d::Zero());
-}
-
-double SrgbToLinear(std::uint8_t value) {
-  const double c = value / 255.0;
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
-
-std::string EncodeGlb(const GltfScene& scene) {
-  ValidateScene(scene);
-  json root;
-  root["asset"] = {{"version", "2.0"}, {"generator", "mmh (MotionMontage harness)"}};
-  root["bufferViews"] = json::array();
-  root["accessors"] = json::array();
-  root["materials"] = json::array(
+// The two materials: the blocks' vertex colours, and the spatial markers' grey.
+json Materials() {
+  return json::array(
       {{{"name", "block colours"},
         {"pbrMetallicRoughness",
          {{"baseColorFactor", {1.0, 1.0, 1.0, 1.0}}, {"metallicFactor", 0.0},
@@ -181,13 +160,17 @@ std::string EncodeGlb(const GltfScene& scene) {
          {{"baseColorFactor", {kMarkerGrey, kMarkerGrey, kMarkerGrey, 1.0}},
           {"metallicFactor", 0.0},
           {"roughnessFactor", 0.9}}}}});
-  BufferBuilder buffer(&root);
+}
 
-  // Vertex data per source mesh: three vertices per non-degenerate face, flat normals.
-  struct MeshAccessors {
-    int position = -1, normal = -1, color = -1;
-  };
-  std::vector<MeshAccessors> mesh_accessors(scene.meshes.size());
+// The accessors of one source mesh's vertex data (-1: the mesh is used by no node).
+struct MeshAccessors {
+  int position = -1, normal = -1, color = -1;
+};
+
+// Vertex data per source mesh a node uses: three vertices per non-degenerate face, flat normals,
+// linear colours. InputError for a used mesh with only degenerate faces.
+std::vector<MeshAccessors> AddMeshData(const GltfScene& scene, BufferBuilder* buffer) {
+  std::vector<MeshAccessors> accessors(scene.meshes.size());
   std::vector<bool> used(scene.meshes.size(), false);
   for (const GltfNode& node : scene.nodes) {
     if (node.mesh >= 0) used[node.mesh] = true;
@@ -212,15 +195,21 @@ std::string EncodeGlb(const GltfScene& scene) {
       ThrowBadValue("glTF mesh " + scene.mesh_names[m], "only degenerate faces",
                     "at least one face with an area");
     }
-    mesh_accessors[m].position = buffer.AddFloats(positions, 3, "VEC3", true, true);
-    mesh_accessors[m].normal = buffer.AddFloats(vertex_normals, 3, "VEC3", true, false);
-    mesh_accessors[m].color = buffer.AddFloats(colors, 3, "VEC3", true, false);
+    accessors[m].position = buffer->AddFloats(positions, 3, "VEC3", true, true);
+    accessors[m].normal = buffer->AddFloats(vertex_normals, 3, "VEC3", true, false);
+    accessors[m].color = buffer->AddFloats(colors, 3, "VEC3", true, false);
   }
+  return accessors;
+}
 
-  // One glTF mesh per (mesh, look) pair in use; the looks share the vertex accessors.
+// root["nodes"] and root["meshes"]: one glTF mesh per (mesh, look) pair in use, the looks sharing
+// the vertex accessors; the marker material is dropped when no node is grey (unused objects are
+// the validator's infos).
+void AddNodesAndMeshes(const GltfScene& scene, const std::vector<MeshAccessors>& accessors,
+                       json* root) {
   std::map<std::pair<int, NodeLook>, int> gltf_meshes;
-  root["meshes"] = json::array();
-  root["nodes"] = json::array();
+  (*root)["meshes"] = json::array();
+  (*root)["nodes"] = json::array();
   for (const GltfNode& node : scene.nodes) {
     json out = PoseTrs(node.parent_T_node);
     out["name"] = node.name;
@@ -229,98 +218,120 @@ std::string EncodeGlb(const GltfScene& scene) {
       const auto key = std::make_pair(node.mesh, node.look);
       auto it = gltf_meshes.find(key);
       if (it == gltf_meshes.end()) {
-        const MeshAccessors& a = mesh_accessors[node.mesh];
+        const MeshAccessors& a = accessors[node.mesh];
         json attributes = {{"POSITION", a.position}, {"NORMAL", a.normal}};
         if (node.look == NodeLook::kColored) attributes["COLOR_0"] = a.color;
         const bool grey = node.look == NodeLook::kGrey;
-        root["meshes"].push_back(
+        (*root)["meshes"].push_back(
             {{"name", scene.mesh_names[node.mesh] + (grey ? " (marker)" : "")},
              {"primitives", {{{"attributes", attributes}, {"material", grey ? 1 : 0}}}}});
-        it = gltf_meshes.emplace(key, static_cast<int>(root["meshes"].size()) - 1).first;
+        it = gltf_meshes.emplace(key, static_cast<int>((*root)["meshes"].size()) - 1).first;
       }
       out["mesh"] = it->second;
     }
-    root["nodes"].push_back(out);
+    (*root)["nodes"].push_back(out);
   }
-  if (root["meshes"].empty()) root.erase("meshes");
+  if ((*root)["meshes"].empty()) root->erase("meshes");
   const bool any_grey = std::any_of(scene.nodes.begin(), scene.nodes.end(), [](const GltfNode& n) {
     return n.mesh >= 0 && n.look == NodeLook::kGrey;
   });
-  if (!any_grey) root["materials"].erase(1);  // unused objects are the validator's infos
+  if (!any_grey) (*root)["materials"].erase(1);
+}
 
-  // Animations: per track one time accessor shared by a translation and a rotation sampler.
-  for (const GltfAnimation& animation : scene.animations) {
-    json out = {{"name", animation.name},
-                {"samplers", json::array()},
-                {"channels", json::array()},
-                {"extras", {{"mmh_time_origins_s", json::object()}}}};
-    for (const GltfTrack& track : animation.tracks) {
-      const Trajectory& poses = track.parent_T_node;
-      out["extras"]["mmh_time_origins_s"][scene.nodes[track.node].name] = track.time_origin;
-      std::vector<float> times, translations, rotations;
-      double max_time_error = 0.0;
-      Eigen::Quaterniond previous = poses.poses.front().rotation;
-      for (std::size_t i = 0; i < poses.size(); ++i) {
-        const float time = static_cast<float>(poses.timestamps[i] - track.time_origin);
-        if (!times.empty() && !(time > times.back())) {
-          ThrowBadValue("glTF animation " + animation.name + " node " +
-                            scene.nodes[track.node].name + " frame " + std::to_string(i),
-                        "timestamp " + FormatNumber(poses.timestamps[i]),
-                        "times that stay strictly increasing as 32-bit floats after subtracting " +
-                            FormatNumber(track.time_origin) + " s");
-        }
-        times.push_back(time);
-        max_time_error = std::max(max_time_error,
-                                  std::abs(double(time) - (poses.timestamps[i] - track.time_origin)));
-        Eigen::Quaterniond q = poses.poses[i].rotation.normalized();
-        if (q.coeffs().dot(previous.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
-        previous = q;
-        for (int c = 0; c < 3; ++c) translations.push_back(static_cast<float>(poses.poses[i].translation(c)));
-        for (int c = 0; c < 4; ++c) rotations.push_back(static_cast<float>(q.coeffs()(c)));  // x y z w
-      }
-      // The input accessor must be 32-bit floats (glTF 2.0, "Animations"): half a unit in the last
-      // place is 4.8e-7 s below 16 s, 9.5e-7 s from 16 s on, 3.8e-6 s at 100 s. Beyond 5e-7 s
-      // the exact times go to the extras too: the frame period of an evenly sampled track
-      // (timestamps origin + i * period to 5e-7 s), else every time after the origin (JSON
-      // doubles).
-      if (max_time_error > kExactTimeError) {
-        const std::string& name = scene.nodes[track.node].name;
-        const double period = poses.size() > 1 ? (poses.timestamps.back() - poses.timestamps.front()) /
-                                                     static_cast<double>(poses.size() - 1)
-                                               : 0.0;
-        bool even = poses.size() > 1;
-        for (std::size_t i = 0; i < poses.size() && even; ++i) {
-          even = std::abs(poses.timestamps.front() + double(i) * period - poses.timestamps[i]) <= kExactTimeError;
-        }
-        if (even && poses.timestamps.front() == track.time_origin) {
-          out["extras"]["mmh_frame_periods_s"][name] = period;
-        } else {
-          json exact = json::array();
-          for (double t : poses.timestamps) exact.push_back(t - track.time_origin);
-          out["extras"]["mmh_times_s"][name] = exact;
-        }
-      }
-      const int input = buffer.AddFloats(times, 1, "SCALAR", false, true);
-      const int translation = buffer.AddFloats(translations, 3, "VEC3", false, false);
-      const int rotation = buffer.AddFloats(rotations, 4, "VEC4", false, false);
-      const int first = static_cast<int>(out["samplers"].size());
-      out["samplers"].push_back({{"input", input}, {"output", translation}, {"interpolation", "LINEAR"}});
-      out["samplers"].push_back({{"input", input}, {"output", rotation}, {"interpolation", "LINEAR"}});
-      out["channels"].push_back({{"sampler", first}, {"target", {{"node", track.node}, {"path", "translation"}}}});
-      out["channels"].push_back({{"sampler", first + 1}, {"target", {{"node", track.node}, {"path", "rotation"}}}});
+// A track's keyframes as glTF stores them: float32 times after the origin, translations, and
+// rotations (x y z w, signs chosen so that consecutive quaternions interpolate the short way).
+struct TrackSamples {
+  std::vector<float> times, translations, rotations;
+  double max_time_error = 0.0;  // [s], the float32 times against the exact ones
+};
+
+TrackSamples SampleTrack(const GltfScene& scene, const GltfAnimation& animation,
+                         const GltfTrack& track) {
+  const Trajectory& poses = track.parent_T_node;
+  TrackSamples samples;
+  Eigen::Quaterniond previous = poses.poses.front().rotation;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const float time = static_cast<float>(poses.timestamps[i] - track.time_origin);
+    if (!samples.times.empty() && !(time > samples.times.back())) {
+      ThrowBadValue("glTF animation " + animation.name + " node " + scene.nodes[track.node].name +
+                        " frame " + std::to_string(i),
+                    "timestamp " + FormatNumber(poses.timestamps[i]),
+                    "times that stay strictly increasing as 32-bit floats after subtracting " +
+                        FormatNumber(track.time_origin) + " s");
     }
-    if (!out["channels"].empty()) root["animations"].push_back(out);
+    samples.times.push_back(time);
+    samples.max_time_error =
+        std::max(samples.max_time_error,
+                 std::abs(double(time) - (poses.timestamps[i] - track.time_origin)));
+    Eigen::Quaterniond q = poses.poses[i].rotation.normalized();
+    if (q.coeffs().dot(previous.coeffs()) < 0.0) q.coeffs() = -q.coeffs();
+    previous = q;
+    for (int c = 0; c < 3; ++c) {
+      samples.translations.push_back(static_cast<float>(poses.poses[i].translation(c)));
+    }
+    for (int c = 0; c < 4; ++c) samples.rotations.push_back(static_cast<float>(q.coeffs()(c)));
   }
-  root["scene"] = 0;
-  root["scenes"] = json::array({{{"nodes", scene.roots}}});
+  return samples;
+}
 
-  std::string bin = buffer.bytes();
+// The input accessor must be 32-bit floats (glTF 2.0, "Animations"): half a unit in the last place
+// is 4.8e-7 s below 16 s, 9.5e-7 s from 16 s on, 3.8e-6 s at 100 s. Beyond 5e-7 s the exact times
+// go to the animation's extras too: the frame period of an evenly sampled track (timestamps
+// origin + i * period to 5e-7 s), else every time after the origin (JSON doubles).
+void AddExactTimes(const std::string& name, const GltfTrack& track, json* extras) {
+  const Trajectory& poses = track.parent_T_node;
+  const double period = poses.size() > 1 ? (poses.timestamps.back() - poses.timestamps.front()) /
+                                               static_cast<double>(poses.size() - 1)
+                                         : 0.0;
+  bool even = poses.size() > 1;
+  for (std::size_t i = 0; i < poses.size() && even; ++i) {
+    even = std::abs(poses.timestamps.front() + double(i) * period - poses.timestamps[i]) <=
+           kExactTimeError;
+  }
+  if (even && poses.timestamps.front() == track.time_origin) {
+    (*extras)["mmh_frame_periods_s"][name] = period;
+  } else {
+    json exact = json::array();
+    for (double t : poses.timestamps) exact.push_back(t - track.time_origin);
+    (*extras)["mmh_times_s"][name] = exact;
+  }
+}
+
+// One animation: per track one time accessor shared by a translation and a rotation sampler.
+json AnimationJson(const GltfScene& scene, const GltfAnimation& animation,
+                   BufferBuilder* buffer) {
+  json out = {{"name", animation.name},
+              {"samplers", json::array()},
+              {"channels", json::array()},
+              {"extras", {{"mmh_time_origins_s", json::object()}}}};
+  for (const GltfTrack& track : animation.tracks) {
+    const std::string& name = scene.nodes[track.node].name;
+    out["extras"]["mmh_time_origins_s"][name] = track.time_origin;
+    const TrackSamples samples = SampleTrack(scene, animation, track);
+    if (samples.max_time_error > kExactTimeError) AddExactTimes(name, track, &out["extras"]);
+    const int input = buffer->AddFloats(samples.times, 1, "SCALAR", false, true);
+    const int translation = buffer->AddFloats(samples.translations, 3, "VEC3", false, false);
+    const int rotation = buffer->AddFloats(samples.rotations, 4, "VEC4", false, false);
+    const int first = static_cast<int>(out["samplers"].size());
+    out["samplers"].push_back(
+        {{"input", input}, {"output", translation}, {"interpolation", "LINEAR"}});
+    out["samplers"].push_back({{"input", input}, {"output", rotation}, {"interpolation", "LINEAR"}});
+    out["channels"].push_back(
+        {{"sampler", first}, {"target", {{"node", track.node}, {"path", "translation"}}}});
+    out["channels"].push_back(
+        {{"sampler", first + 1}, {"target", {{"node", track.node}, {"path", "rotation"}}}});
+  }
+  return out;
+}
+
+// The binary glTF container (glTF 2.0, "GLB File Format Specification"): a 12-byte header, the
+// JSON chunk padded with spaces and the binary chunk padded with zeros to 4 bytes.
+std::string GlbContainer(json root, std::string bin) {
   while (bin.size() % 4 != 0) bin.push_back('\0');
   if (!bin.empty()) root["buffers"] = json::array({{{"byteLength", bin.size()}}});
   else root.erase("bufferViews"), root.erase("accessors");
   std::string text = root.dump();
   while (text.size() % 4 != 0) text.push_back(' ');
-
   std::string glb;
   const std::size_t total = 12 + 8 + text.size() + (bin.empty() ? 0 : 8 + bin.size());
   AppendU32(&glb, kGlbMagic);
@@ -335,6 +346,41 @@ std::string EncodeGlb(const GltfScene& scene) {
     glb += bin;
   }
   return glb;
+}
+
+}  // namespace
+
+Rigid3 GltfTFrame(TrajectoryFrame frame) {
+  if (frame == TrajectoryFrame::kTable) {
+    // (x, y, z) -> (x, z, -y): -90 deg about x.
+    return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX())),
+                  Eigen::Vector3d::Zero());
+  }
+  // (x, y, z) -> (x, -y, -z): 180 deg about x.
+  return Rigid3(Eigen::Quaterniond(0.0, 1.0, 0.0, 0.0), Eigen::Vector3d::Zero());
+}
+
+double SrgbToLinear(std::uint8_t value) {
+  const double c = value / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+std::string EncodeGlb(const GltfScene& scene) {
+  ValidateScene(scene);
+  json root;
+  root["asset"] = {{"version", "2.0"}, {"generator", "mmh (MotionMontage harness)"}};
+  root["bufferViews"] = json::array();
+  root["accessors"] = json::array();
+  root["materials"] = Materials();
+  BufferBuilder buffer(&root);
+  AddNodesAndMeshes(scene, AddMeshData(scene, &buffer), &root);
+  for (const GltfAnimation& animation : scene.animations) {
+    json out = AnimationJson(scene, animation, &buffer);
+    if (!out["channels"].empty()) root["animations"].push_back(out);
+  }
+  root["scene"] = 0;
+  root["scenes"] = json::array({{{"nodes", scene.roots}}});
+  return GlbContainer(std::move(root), buffer.bytes());
 }
 
 void WriteGlb(const std::filesystem::path& path, const GltfScene& scene) {

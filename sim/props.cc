@@ -334,134 +334,177 @@ void HandOptions::Validate(const std::string& prefix) const {
   }
 }
 
-TriangleMesh BuildHandAndForearm(const HandOptions& options) {
-  options.Validate("hand");
-  const int segments = options.segments;
-  const Rgb8 skin = kSkinColor;
-  // Built at adult size and scaled at the end, so the grip is built for grip_width / scale.
-  const double half_grip = 0.5 * options.grip_width / options.scale;
-  // Palm frame: u across the palm toward the thumb, a from the wrist to the knuckles, n out of the
-  // palm's inner face (u x a = n, right-handed).
-  const double pitch = options.hand_pitch;
-  const Eigen::Vector3d u = Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d a(0.0, -std::cos(pitch), -std::sin(pitch));
-  const Eigen::Vector3d n = u.cross(a);
+namespace {
 
-  // Palm [m]: width along u, length along a, thickness along n: a slab with rounded edges.
-  constexpr double kPalmWidth = 0.080;
-  constexpr double kPalmLength = 0.090;
-  constexpr double kPalmThickness = 0.026;
-  const double edge_a = 0.5 * (kPalmLength - kPalmThickness);
-  const double edge_u = 0.5 * (kPalmWidth - kPalmThickness);
-  const double edge_r = 0.5 * kPalmThickness;
+// The hand's geometry, built at adult size (scaled at the end, so the grip is built for
+// grip_width / scale). The palm frame: u across the palm toward the thumb, a from the wrist to the
+// knuckles, n out of the palm's inner face (u x a = n, right-handed).
+struct HandFrame {
+  int segments = 16;
+  double half_grip = 0.0;
+  double pitch = 0.0;
+  Eigen::Vector3d u, a, n;
+  Eigen::Vector3d palm;  // the palm's centre
+};
 
-  // Fingers: offset along u, set-back of the knuckle along -a, radius, phalanx lengths [m]. The
-  // joints flex by 0.6, 1 and 0.8 times finger_curl, cumulatively, toward the palm side.
-  struct Finger {
-    double offset, setback, radius;
-    double lengths[3];
-  };
-  constexpr Finger kFingers[] = {
-      {0.029, 0.004, 0.0090, {0.044, 0.026, 0.020}},   // index
-      {0.010, 0.000, 0.0092, {0.048, 0.030, 0.021}},   // middle
-      {-0.009, 0.004, 0.0088, {0.045, 0.028, 0.020}},  // ring
-      {-0.027, 0.014, 0.0078, {0.036, 0.021, 0.018}},  // little
-  };
+// Palm [m]: width along u, length along a, thickness along n: a slab with rounded edges.
+constexpr double kPalmWidth = 0.080;
+constexpr double kPalmLength = 0.090;
+constexpr double kPalmThickness = 0.026;
+constexpr double kPalmEdgeA = 0.5 * (kPalmLength - kPalmThickness);
+constexpr double kPalmEdgeU = 0.5 * (kPalmWidth - kPalmThickness);
+constexpr double kPalmEdgeRadius = 0.5 * kPalmThickness;
+// The fingertips' and the thumb's pads are this far below the grasp point.
+constexpr double kPinchDepth = 0.010;
+
+// Fingers: offset along u, set-back of the knuckle along -a, radius, phalanx lengths [m]. The
+// joints flex by 0.6, 1 and 0.8 times finger_curl, cumulatively, toward the palm side.
+struct Finger {
+  double offset, setback, radius;
+  double lengths[3];
+};
+constexpr Finger kFingers[] = {
+    {0.029, 0.004, 0.0090, {0.044, 0.026, 0.020}},   // index
+    {0.010, 0.000, 0.0092, {0.048, 0.030, 0.021}},   // middle
+    {-0.009, 0.004, 0.0088, {0.045, 0.028, 0.020}},  // ring
+    {-0.027, 0.014, 0.0078, {0.036, 0.021, 0.018}},  // little
+};
+
+double PhalanxRadius(const Finger& finger, int j) { return finger.radius * (1.0 - 0.07 * j); }
+
+// The last phalanx's length includes its rounded tip.
+double PhalanxLength(const Finger& finger, int j) {
+  return finger.lengths[j] - (j == 2 ? PhalanxRadius(finger, j) : 0.0);
+}
+
+// The direction of each phalanx of a curled finger.
+struct FingerCurl {
+  double joint_angles[3];
+  Eigen::Vector3d Direction(const HandFrame& h, int j) const {
+    return Eigen::Vector3d(h.a * std::cos(joint_angles[j]) + h.n * std::sin(joint_angles[j]));
+  }
+};
+
+// The last phalanx at least straight down (angle pi/2 below horizontal) so it never leans into the
+// proxy.
+FingerCurl Curl(const HandOptions& options) {
   const double k = options.finger_curl;
-  // The last phalanx at least straight down (angle pi/2 below horizontal) so it never leans into
-  // the proxy.
-  const double joint_angles[3] = {0.6 * k, 1.6 * k,
-                                  std::max(2.4 * k, 0.5 * std::numbers::pi - pitch)};
-  auto phalanx_direction = [&](int j) {
-    return Eigen::Vector3d(a * std::cos(joint_angles[j]) + n * std::sin(joint_angles[j]));
-  };
-  const Eigen::Vector3d last_direction = phalanx_direction(2);
-  auto phalanx_radius = [](const Finger& finger, int j) {
-    return finger.radius * (1.0 - 0.07 * j);
-  };
-  // The last phalanx's length includes its rounded tip.
-  auto phalanx_length = [&](const Finger& finger, int j) {
-    return finger.lengths[j] - (j == 2 ? phalanx_radius(finger, j) : 0.0);
-  };
+  return {{0.6 * k, 1.6 * k, std::max(2.4 * k, 0.5 * std::numbers::pi - options.hand_pitch)}};
+}
 
-  // Place the palm so that the middle fingertip's pad touches the proxy's front: its tip centre at
-  // y = -(half_grip + radius), kPinchDepth below the grasp point (in the grip frame's y-z plane).
-  constexpr double kPinchDepth = 0.010;
+// The palm placed so that the middle fingertip's pad touches the proxy's front: its tip centre at
+// y = -(half_grip + radius), kPinchDepth below the grasp point (in the grip frame's y-z plane).
+HandFrame PlaceHand(const HandOptions& options, const FingerCurl& curl) {
+  HandFrame h;
+  h.segments = options.segments;
+  h.half_grip = 0.5 * options.grip_width / options.scale;
+  h.pitch = options.hand_pitch;
+  h.u = Eigen::Vector3d::UnitX();
+  h.a = Eigen::Vector3d(0.0, -std::cos(h.pitch), -std::sin(h.pitch));
+  h.n = h.u.cross(h.a);
   const Finger& middle = kFingers[1];
   Eigen::Vector3d knuckle_to_tip = Eigen::Vector3d::Zero();
-  for (int j = 0; j < 3; ++j) knuckle_to_tip += phalanx_direction(j) * phalanx_length(middle, j);
-  const Eigen::Vector3d middle_tip(middle.offset, -(half_grip + phalanx_radius(middle, 2)),
+  for (int j = 0; j < 3; ++j) knuckle_to_tip += curl.Direction(h, j) * PhalanxLength(middle, j);
+  const Eigen::Vector3d middle_tip(middle.offset, -(h.half_grip + PhalanxRadius(middle, 2)),
                                    -kPinchDepth);
-  const Eigen::Vector3d palm =
-      middle_tip - knuckle_to_tip - a * (edge_a - middle.setback) - u * middle.offset;
+  h.palm = middle_tip - knuckle_to_tip - h.a * (kPalmEdgeA - middle.setback) - h.u * middle.offset;
+  return h;
+}
 
-  TriangleMesh mesh;
+void AppendPalm(const HandFrame& h, TriangleMesh* mesh) {
+  const Rgb8 skin = kSkinColor;
   AppendMesh(
       MakeBox({kPalmWidth - kPalmThickness, kPalmLength - kPalmThickness, kPalmThickness}, skin),
-      Rigid3(FromAxes(u, a, n), palm), &mesh);
+      Rigid3(FromAxes(h.u, h.a, h.n), h.palm), mesh);
   for (const double s : {-1.0, 1.0}) {
-    AppendMesh(MakeCapsuleBetween(palm + s * a * edge_a - u * edge_u,
-                                  palm + s * a * edge_a + u * edge_u, edge_r, segments, skin),
-               Rigid3::Identity(), &mesh);
-    AppendMesh(MakeCapsuleBetween(palm + s * u * edge_u - a * edge_a,
-                                  palm + s * u * edge_u + a * edge_a, edge_r, segments, skin),
-               Rigid3::Identity(), &mesh);
+    AppendMesh(MakeCapsuleBetween(h.palm + s * h.a * kPalmEdgeA - h.u * kPalmEdgeU,
+                                  h.palm + s * h.a * kPalmEdgeA + h.u * kPalmEdgeU,
+                                  kPalmEdgeRadius, h.segments, skin),
+               Rigid3::Identity(), mesh);
+    AppendMesh(MakeCapsuleBetween(h.palm + s * h.u * kPalmEdgeU - h.a * kPalmEdgeA,
+                                  h.palm + s * h.u * kPalmEdgeU + h.a * kPalmEdgeA,
+                                  kPalmEdgeRadius, h.segments, skin),
+               Rigid3::Identity(), mesh);
   }
-  // Each finger's last phalanx points down at the nominal angle with its tip's pad on the front
-  // plane (the little finger, the shortest, a little higher); the proximal and middle phalanges
-  // reach its last joint by two-link inverse kinematics, the middle joint bulging to the back of
-  // the hand. For the middle finger this is the nominal pose the palm was placed by.
-  for (const Finger& finger : kFingers) {
-    const Eigen::Vector3d knuckle = palm + a * (edge_a - finger.setback) + u * finger.offset;
-    const double tip_radius = phalanx_radius(finger, 2);
-    const double lift = &finger == &kFingers[3] ? 0.006 : 0.0;
-    const Eigen::Vector3d tip(finger.offset, -(half_grip + tip_radius), -kPinchDepth + lift);
-    const Eigen::Vector3d last_joint = tip - last_direction * phalanx_length(finger, 2);
-    const Eigen::Vector3d middle_joint =
-        TwoLinkJoint(knuckle, last_joint, phalanx_length(finger, 0), phalanx_length(finger, 1), -n);
-    AppendMesh(MakeCapsuleBetween(knuckle, middle_joint, phalanx_radius(finger, 0), segments, skin),
-               Rigid3::Identity(), &mesh);
-    AppendMesh(
-        MakeCapsuleBetween(middle_joint, last_joint, phalanx_radius(finger, 1), segments, skin),
-        Rigid3::Identity(), &mesh);
-    AppendMesh(MakeCapsuleBetween(last_joint, tip, tip_radius, segments, skin), Rigid3::Identity(),
-               &mesh);
-  }
+}
 
-  // Thumb: the metacarpal (the thenar eminence) from the middle of the palm's +u side, then the
-  // two phalanges, reaching the proxy's back face (pad at y = +half_grip, kPinchDepth below the
-  // grasp point, a little toward +x). Two-link inverse kinematics, the knuckle bulging outward
-  // (+x) and up; a target out of reach leaves the thumb stretched toward it.
+// Each finger's last phalanx points down at the nominal angle with its tip's pad on the front
+// plane (the little finger, the shortest, a little higher); the proximal and middle phalanges
+// reach its last joint by two-link inverse kinematics, the middle joint bulging to the back of the
+// hand. For the middle finger this is the nominal pose the palm was placed by.
+void AppendFingers(const HandFrame& h, const FingerCurl& curl, TriangleMesh* mesh) {
+  const Rgb8 skin = kSkinColor;
+  const Eigen::Vector3d last_direction = curl.Direction(h, 2);
+  for (const Finger& finger : kFingers) {
+    const Eigen::Vector3d knuckle = h.palm + h.a * (kPalmEdgeA - finger.setback) + h.u * finger.offset;
+    const double tip_radius = PhalanxRadius(finger, 2);
+    const double lift = &finger == &kFingers[3] ? 0.006 : 0.0;
+    const Eigen::Vector3d tip(finger.offset, -(h.half_grip + tip_radius), -kPinchDepth + lift);
+    const Eigen::Vector3d last_joint = tip - last_direction * PhalanxLength(finger, 2);
+    const Eigen::Vector3d middle_joint = TwoLinkJoint(knuckle, last_joint, PhalanxLength(finger, 0),
+                                                      PhalanxLength(finger, 1), -h.n);
+    AppendMesh(
+        MakeCapsuleBetween(knuckle, middle_joint, PhalanxRadius(finger, 0), h.segments, skin),
+        Rigid3::Identity(), mesh);
+    AppendMesh(
+        MakeCapsuleBetween(middle_joint, last_joint, PhalanxRadius(finger, 1), h.segments, skin),
+        Rigid3::Identity(), mesh);
+    AppendMesh(MakeCapsuleBetween(last_joint, tip, tip_radius, h.segments, skin),
+               Rigid3::Identity(), mesh);
+  }
+}
+
+// Thumb: the metacarpal (the thenar eminence) from the middle of the palm's +u side, then the two
+// phalanges, reaching the proxy's back face (pad at y = +half_grip, kPinchDepth below the grasp
+// point, a little toward +x). Two-link inverse kinematics, the knuckle bulging outward (+x) and
+// up; a target out of reach leaves the thumb stretched toward it.
+void AppendThumb(const HandFrame& h, TriangleMesh* mesh) {
+  const Rgb8 skin = kSkinColor;
   constexpr double kMetacarpal = 0.046;
   constexpr double kThumbTip = 0.052;  // both phalanges, straight, to the tip's centre
   constexpr double kThumbRadius = 0.0105;
-  const Eigen::Vector3d thumb_base = palm + u * edge_u + n * (0.5 * kPalmThickness - 0.008);
-  const Eigen::Vector3d thumb_tip(0.006, half_grip + kThumbRadius, -kPinchDepth);
+  const Eigen::Vector3d thumb_base = h.palm + h.u * kPalmEdgeU + h.n * (0.5 * kPalmThickness - 0.008);
+  const Eigen::Vector3d thumb_tip(0.006, h.half_grip + kThumbRadius, -kPinchDepth);
   const Eigen::Vector3d thumb_knuckle =
-      TwoLinkJoint(thumb_base, thumb_tip, kMetacarpal, kThumbTip, u + Eigen::Vector3d::UnitZ());
+      TwoLinkJoint(thumb_base, thumb_tip, kMetacarpal, kThumbTip, h.u + Eigen::Vector3d::UnitZ());
   const Eigen::Vector3d thumb_end =
       thumb_knuckle + (thumb_tip - thumb_knuckle).normalized() * kThumbTip;
-  AppendMesh(MakeCapsuleBetween(thumb_base, thumb_knuckle, 0.014, segments, skin),
-             Rigid3::Identity(), &mesh);
-  AppendMesh(MakeCapsuleBetween(thumb_knuckle, thumb_end, kThumbRadius, segments, skin),
-             Rigid3::Identity(), &mesh);
+  AppendMesh(MakeCapsuleBetween(thumb_base, thumb_knuckle, 0.014, h.segments, skin),
+             Rigid3::Identity(), mesh);
+  AppendMesh(MakeCapsuleBetween(thumb_knuckle, thumb_end, kThumbRadius, h.segments, skin),
+             Rigid3::Identity(), mesh);
+}
 
-  // Wrist and forearm: an oval cross-section (1.3 times wider across u than deep), 48 mm deep at
-  // the wrist and 72 mm at the far end, rising from the heel of the palm at forearm_elevation.
-  const Eigen::Vector3d wrist = palm - a * (0.5 * kPalmLength - 0.006);
+// Wrist and forearm: an oval cross-section (1.3 times wider across u than deep), 48 mm deep at the
+// wrist and 72 mm at the far end, rising from the heel of the palm at forearm_elevation.
+void AppendForearm(const HandFrame& h, const HandOptions& options, TriangleMesh* mesh) {
+  const Rgb8 skin = kSkinColor;
+  const Eigen::Vector3d wrist = h.palm - h.a * (0.5 * kPalmLength - 0.006);
   const Eigen::Vector3d f(0.0, std::cos(options.forearm_elevation),
                           std::sin(options.forearm_elevation));
-  const Eigen::Quaterniond forearm_rotation = FromAxes(u, f.cross(u), f);
+  const Eigen::Quaterniond forearm_rotation = FromAxes(h.u, f.cross(h.u), f);
   const Eigen::Vector3f oval(1.3f, 1.0f, 1.0f);
   constexpr double kWristRadius = 0.024;
   constexpr double kElbowRadius = 0.036;
-  AppendMesh(Scaled(MakeSphere(kWristRadius, 2 * segments, skin), oval),
-             Rigid3(forearm_rotation, wrist), &mesh);
+  AppendMesh(Scaled(MakeSphere(kWristRadius, 2 * h.segments, skin), oval),
+             Rigid3(forearm_rotation, wrist), mesh);
   AppendMesh(Scaled(MakeFrustum(kWristRadius, kElbowRadius, options.forearm_length / options.scale,
-                                2 * segments, skin),
+                                2 * h.segments, skin),
                     oval),
-             Rigid3(forearm_rotation, wrist), &mesh);
+             Rigid3(forearm_rotation, wrist), mesh);
+}
 
+}  // namespace
+
+TriangleMesh BuildHandAndForearm(const HandOptions& options) {
+  options.Validate("hand");
+  const FingerCurl curl = Curl(options);
+  const HandFrame hand = PlaceHand(options, curl);
+  TriangleMesh mesh;
+  AppendPalm(hand, &mesh);
+  AppendFingers(hand, curl, &mesh);
+  AppendThumb(hand, &mesh);
+  AppendForearm(hand, options, &mesh);
   if (options.scale != 1.0) mesh.vertices *= static_cast<float>(options.scale);
   return mesh;
 }

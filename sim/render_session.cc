@@ -350,6 +350,57 @@ void WriteStoryFiles(const Motion& motion, const people::PeopleConfig& people,
   WriteFileAtomically(out / "participant.json", participant.dump(2) + "\n");
 }
 
+// The scene and sensor of each rendering thread, and the workers that pose the scene for a frame.
+struct SceneWorkers {
+  SceneWorkers(const RenderConfig& config, const TriangleMesh& proxy_model, const Motion& motion,
+               int count) {
+    for (int w = 0; w < count; ++w) {
+      scenes.push_back(std::make_unique<TableTopScene>(config, proxy_model));
+      sensors.push_back(std::make_unique<KinectSensor>(config.sensor, &scenes.back()->scene(),
+                                                       scenes.back()->table_T_camera()));
+      TableTopScene* scene = scenes.back().get();
+      workers.push_back({[scene, &motion](int i) {
+                           scene->SetFrame(motion.table_T_proxy[i], motion.slider[i], motion.hand);
+                         },
+                         sensors.back().get()});
+    }
+  }
+  std::vector<std::unique_ptr<TableTopScene>> scenes;
+  std::vector<std::unique_ptr<KinectSensor>> sensors;
+  std::vector<SensorWorker> workers;
+};
+
+// camera.json of the rendered folder: the sensor's intrinsics, registration and calibration.
+RgbdCameraInfo CameraInfo(const KinectSensor& sensor, const RenderConfig& config) {
+  RgbdCameraInfo camera;
+  camera.depth_intrinsics = sensor.depth_intrinsics();
+  camera.color_intrinsics = sensor.color_intrinsics();
+  camera.depth_scale = kTumDepthScale;
+  camera.color_T_depth = sensor.color_T_depth();
+  camera.sensor = {{"model", "mmh synthetic Kinect v1"},
+                   {"registered", config.sensor.registered},
+                   {"calibration", mmh::ToJson(config.sensor.calibration)},
+                   {"seed", config.sensor.seed}};
+  camera.png_compression = config.render.png_compression;
+  return camera;
+}
+
+// scene.json: the setup's calibration, for the tracker: where the camera stands and where the Like
+// box is.
+nlohmann::json SetupJson(const Rigid3& camera_T_table, const RenderConfig& config) {
+  nlohmann::json scene_json;
+  scene_json["camera_T_table"] = {{"translation",
+                                   {camera_T_table.translation.x(), camera_T_table.translation.y(),
+                                    camera_T_table.translation.z()}},
+                                  {"quaternion_xyzw",
+                                   {camera_T_table.rotation.x(), camera_T_table.rotation.y(),
+                                    camera_T_table.rotation.z(), camera_T_table.rotation.w()}}};
+  scene_json["table"] = mmh::ToJson(config.scene);
+  scene_json["slider_block_size"] = config.scene.slider_block_size;
+  scene_json["groundtruth"] = "groundtruth.txt: camera_T_proxy of the depth camera";
+  return scene_json;
+}
+
 }  // namespace
 
 RenderSummary RenderSequence(
@@ -363,32 +414,11 @@ RenderSummary RenderSequence(
   // One scene and sensor per thread: frames render in parallel (RenderFrames) and come back in
   // order; their PNGs are encoded in parallel too. The bytes do not depend on the thread count.
   const int threads = std::max(1, tbb::this_task_arena::max_concurrency());
-  std::vector<std::unique_ptr<TableTopScene>> scenes;
-  std::vector<std::unique_ptr<KinectSensor>> sensors;
-  std::vector<SensorWorker> workers;
-  for (int w = 0; w < std::min(threads, motion.frames); ++w) {
-    scenes.push_back(std::make_unique<TableTopScene>(config, proxy_model));
-    sensors.push_back(std::make_unique<KinectSensor>(config.sensor, &scenes.back()->scene(),
-                                                     scenes.back()->table_T_camera()));
-    TableTopScene* scene = scenes.back().get();
-    workers.push_back({[scene, &motion](int i) {
-                         scene->SetFrame(motion.table_T_proxy[i], motion.slider[i], motion.hand);
-                       },
-                       sensors.back().get()});
-  }
-  const KinectSensor& sensor = *sensors.front();
+  const SceneWorkers scene_workers(config, proxy_model, motion, std::min(threads, motion.frames));
+  const std::vector<SensorWorker>& workers = scene_workers.workers;
+  const KinectSensor& sensor = *scene_workers.sensors.front();
   const Rigid3 depth_T_table = sensor.world_T_depth_camera().Inverse();
-
-  RgbdCameraInfo camera;
-  camera.depth_intrinsics = sensor.depth_intrinsics();
-  camera.color_intrinsics = sensor.color_intrinsics();
-  camera.depth_scale = kTumDepthScale;
-  camera.color_T_depth = sensor.color_T_depth();
-  camera.sensor = {{"model", "mmh synthetic Kinect v1"},
-                   {"registered", config.sensor.registered},
-                   {"calibration", mmh::ToJson(config.sensor.calibration)},
-                   {"seed", config.sensor.seed}};
-  camera.png_compression = r.png_compression;
+  const RgbdCameraInfo camera = CameraInfo(sensor, config);
   RgbdFolderWriter writer(out, camera);
   std::unique_ptr<FakenectWriter> fakenect;
   if (r.fakenect) fakenect = std::make_unique<FakenectWriter>(out.string() + ".fakenect");
@@ -446,18 +476,7 @@ RenderSummary RenderSequence(
   }
   summary.timings = TotalTimings(workers);
 
-  // The setup's calibration, for the tracker: where the camera stands and where the Like box is.
-  nlohmann::json scene_json;
-  const Rigid3 camera_T_table = depth_T_table;
-  scene_json["camera_T_table"] = {{"translation",
-                                   {camera_T_table.translation.x(), camera_T_table.translation.y(),
-                                    camera_T_table.translation.z()}},
-                                  {"quaternion_xyzw",
-                                   {camera_T_table.rotation.x(), camera_T_table.rotation.y(),
-                                    camera_T_table.rotation.z(), camera_T_table.rotation.w()}}};
-  scene_json["table"] = mmh::ToJson(config.scene);
-  scene_json["slider_block_size"] = config.scene.slider_block_size;
-  scene_json["groundtruth"] = "groundtruth.txt: camera_T_proxy of the depth camera";
+  const nlohmann::json scene_json = SetupJson(depth_T_table, config);
   // Everything goes into the staging folder before it is moved into place: a kill at any moment
   // leaves no partial folder under `out` (a later render removes the staging folder).
   const std::filesystem::path& staging = writer.staging();

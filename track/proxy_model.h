@@ -88,6 +88,10 @@ class ProxyModel {
   const std::vector<int>& sparse_samples() const { return sparse_; }
 
  private:
+  // The nearest-sample grid over the model's bounds and its blocks (Closest's lookup), from the
+  // samples.
+  void BuildGrid(const Bounds3& bounds, const Eigen::Vector3d& size);
+
   ProxyModelOptions options_;
   std::vector<Eigen::Vector3f> points_;
   std::vector<Eigen::Vector3f> normals_;
