@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "core/atomic_file.h"
@@ -169,74 +170,88 @@ std::vector<MetricAxisPlot> MetricAxisPlots(const Plan& plan, const std::vector<
   return plots;
 }
 
-Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
-  Aggregate a;
-  const auto& metrics = plan.spec.metrics;
+namespace {
+
+// The cell's row prefix in results.csv and failures.csv: id, point, replicate, seed, parameters.
+std::string CellPrefix(const Cell& cell) {
+  return cell.id + "," + std::to_string(cell.point) + "," + std::to_string(cell.replicate) + "," +
+         (cell.seed ? std::to_string(*cell.seed) : "") + ParamsRow(cell);
+}
+
+// Reads the metrics of the complete cell `cell` into `row` (spec.metrics order); the problem
+// (a file missing or not JSON, a key absent or not a number) or "" when every metric was read.
+std::string ReadCellMetrics(const Plan& plan, const fs::path& dir, const Cell& cell,
+                            ResultRow* row) {
+  std::map<std::string, json> files;
+  for (const auto& m : plan.spec.metrics) {
+    if (!files.count(m.file)) {
+      const fs::path path = CellDir(dir, cell.id) / "out" / m.file;
+      files[m.file] = json(json::value_t::discarded);
+      try {
+        if (fs::exists(path)) files[m.file] = ReadJsonFile(path);
+      } catch (const InputError&) {
+        // reported below as "missing or not JSON", with the cell
+      }
+    }
+    const json& root = files[m.file];
+    const json* value = root.is_discarded() ? nullptr : FindKey(root, m.key);
+    if (!value || !(value->is_number() || value->is_boolean())) {
+      return "metric '" + m.name + "': " +
+             (root.is_discarded() ? "out/" + m.file + " is missing or not JSON"
+                                  : "key '" + m.key + "' in out/" + m.file + " is " +
+                                        (value ? "not a number: " + value->dump()
+                                               : std::string("absent")));
+    }
+    row->metrics.push_back(value->is_boolean() ? (value->get<bool>() ? 1.0 : 0.0)
+                                               : value->get<double>());
+  }
+  return "";
+}
+
+// Step 1: every cell's status and metrics: the rows, the counts, results.csv and failures.csv.
+void GatherCells(const Plan& plan, const fs::path& dir, Aggregate* a) {
   std::string results = "cell,point,replicate,seed" + ParamsHeader(plan);
-  for (const auto& m : metrics) results += "," + m.name;
+  for (const auto& m : plan.spec.metrics) results += "," + m.name;
   results += "\n";
   std::string failures = "cell,point,replicate,seed" + ParamsHeader(plan) +
                          ",exit_code,signal,message\n";
   for (std::size_t i = 0; i < plan.cells.size(); ++i) {
     const Cell& cell = plan.cells[i];
-    const std::string prefix = cell.id + "," + std::to_string(cell.point) + "," +
-                               std::to_string(cell.replicate) + "," +
-                               (cell.seed ? std::to_string(*cell.seed) : "") + ParamsRow(cell);
     const CellStatus status = ReadCellStatus(dir, cell.id);
     if (status.state == CellState::kMissing) {
-      ++a.missing;
+      ++a->missing;
       continue;
     }
     std::string problem;
     ResultRow row{static_cast<int>(i), {}};
     if (status.state == CellState::kComplete) {
-      std::map<std::string, json> files;
-      for (const auto& m : metrics) {
-        if (!files.count(m.file)) {
-          const fs::path path = CellDir(dir, cell.id) / "out" / m.file;
-          files[m.file] = json(json::value_t::discarded);
-          try {
-            if (fs::exists(path)) files[m.file] = ReadJsonFile(path);
-          } catch (const InputError&) {
-            // reported below as "missing or not JSON", with the cell
-          }
-        }
-        const json& root = files[m.file];
-        const json* value = root.is_discarded() ? nullptr : FindKey(root, m.key);
-        if (!value || !(value->is_number() || value->is_boolean())) {
-          problem = "metric '" + m.name + "': " +
-                    (root.is_discarded() ? "out/" + m.file + " is missing or not JSON"
-                                         : "key '" + m.key + "' in out/" + m.file + " is " +
-                                               (value ? "not a number: " + value->dump()
-                                                      : std::string("absent")));
-          break;
-        }
-        row.metrics.push_back(value->is_boolean() ? (value->get<bool>() ? 1.0 : 0.0)
-                                                  : value->get<double>());
-      }
+      problem = ReadCellMetrics(plan, dir, cell, &row);
     } else {
-      std::string message = status.stderr_tail;
-      for (char& c : message) {
+      problem = status.stderr_tail;
+      for (char& c : problem) {
         if (c == '\n' || c == '\r') c = '|';
       }
-      problem = message;
     }
     if (!problem.empty()) {
-      ++a.failed;
-      failures += prefix + "," + std::to_string(status.exit_code) + "," +
+      ++a->failed;
+      failures += CellPrefix(cell) + "," + std::to_string(status.exit_code) + "," +
                   std::to_string(status.signal) + "," + CsvText(problem) + "\n";
       continue;
     }
-    ++a.complete;
-    results += prefix;
+    ++a->complete;
+    results += CellPrefix(cell);
     for (double v : row.metrics) results += "," + CsvNumber(v);
     results += "\n";
-    a.rows.push_back(std::move(row));
+    a->rows.push_back(std::move(row));
   }
-  a.results_csv = results;
-  a.failures_csv = failures;
+  a->results_csv = results;
+  a->failures_csv = failures;
+}
 
-  // summary.csv: per parameter setting, over its replicates.
+// Step 2: summary.csv, per parameter setting over its replicates: n and each metric's chosen
+// statistics.
+std::string SummaryCsv(const Plan& plan, const std::vector<ResultRow>& result_rows) {
+  const auto& metrics = plan.spec.metrics;
   std::string summary = "point" + ParamsHeader(plan) + ",n";
   for (const auto& m : metrics) {
     for (Statistic s : m.statistics) {
@@ -249,7 +264,7 @@ Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
   }
   summary += "\n";
   std::map<int, std::vector<const ResultRow*>> by_point;
-  for (const auto& row : a.rows) by_point[plan.cells[row.cell].point].push_back(&row);
+  for (const auto& row : result_rows) by_point[plan.cells[row.cell].point].push_back(&row);
   for (const auto& [point, rows] : by_point) {
     summary += std::to_string(point) + ParamsRow(plan.cells[rows.front()->cell]) + "," +
                std::to_string(rows.size());
@@ -272,52 +287,79 @@ Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
     }
     summary += "\n";
   }
-  a.summary_csv = summary;
+  return summary;
+}
 
-  // Main effects: the share of each metric's variance between the values of each axis.
+// Step 3: the main effects, the share of each metric's variance between the values of each axis:
+// variance_shares.csv, and its bars in `bars`.
+std::string VarianceSharesCsv(const Plan& plan, const std::vector<ResultRow>& rows,
+                              std::vector<VarianceBar>* bars) {
+  const auto& metrics = plan.spec.metrics;
   std::string variance = "metric,axis,share\n";
-  std::vector<VarianceBar> bars;
   for (std::size_t m = 0; m < metrics.size(); ++m) {
     std::vector<double> values;
-    for (const auto& r : a.rows) values.push_back(r.metrics[m]);
+    for (const auto& r : rows) values.push_back(r.metrics[m]);
     for (std::size_t x = 0; x < plan.axes.size(); ++x) {
-      const double share = VarianceShare(values, GroupsOf(plan, a.rows, x, nullptr));
+      const double share = VarianceShare(values, GroupsOf(plan, rows, x, nullptr));
       variance += metrics[m].name + "," + CsvText(plan.axes[x].key) + "," + CsvNumber(share) + "\n";
-      bars.push_back({metrics[m].name, plan.axes[x].key, share});
+      bars->push_back({metrics[m].name, plan.axes[x].key, share});
     }
   }
-  a.variance_csv = variance;
-  if (a.rows.empty()) return a;
-  a.plots.emplace_back("variance_shares.svg", VarianceSharesSvg(bars));
+  return variance;
+}
 
-  const std::vector<MetricAxisPlot> line_plots = MetricAxisPlots(plan, a.rows);
-  for (std::size_t m = 0; m < metrics.size(); ++m) {
+// The heat map of metric `m` (its mean per cell of the map) over the first two grid axes, if the
+// plan has two.
+std::optional<HeatMap> MetricHeatMap(const Plan& plan, const std::vector<ResultRow>& rows,
+                                     std::size_t m) {
+  std::vector<std::size_t> grid_axes;
+  for (std::size_t x = 0; x < plan.axes.size(); ++x) {
+    if (!plan.axes[x].sampled) grid_axes.push_back(x);
+  }
+  if (grid_axes.size() < 2) return std::nullopt;
+  const std::string& name = plan.spec.metrics[m].name;
+  const std::size_t ax = grid_axes[0], ay = grid_axes[1];
+  HeatMap map;
+  map.title = name + " (mean) over " + plan.axes[ax].key + " and " + plan.axes[ay].key;
+  map.x_label = plan.axes[ax].key;
+  map.y_label = plan.axes[ay].key;
+  const std::vector<int> gx = GroupsOf(plan, rows, ax, &map.x_values);
+  const std::vector<int> gy = GroupsOf(plan, rows, ay, &map.y_values);
+  std::map<std::pair<int, int>, std::vector<double>> cells;
+  for (std::size_t r = 0; r < rows.size(); ++r) cells[{gx[r], gy[r]}].push_back(rows[r].metrics[m]);
+  map.values.assign(map.y_values.size(), std::vector<double>(map.x_values.size(), kNaN));
+  for (const auto& [xy, v] : cells) map.values[xy.second][xy.first] = Describe(v).mean;
+  return map;
+}
+
+// Step 4: the plots: the variance shares, then per metric its plots against each numeric axis and
+// its heat map.
+std::vector<std::pair<std::string, std::string>> Plots(const Plan& plan,
+                                                       const std::vector<ResultRow>& rows,
+                                                       const std::vector<VarianceBar>& bars) {
+  std::vector<std::pair<std::string, std::string>> plots;
+  plots.emplace_back("variance_shares.svg", VarianceSharesSvg(bars));
+  const std::vector<MetricAxisPlot> line_plots = MetricAxisPlots(plan, rows);
+  for (std::size_t m = 0; m < plan.spec.metrics.size(); ++m) {
     for (const MetricAxisPlot& p : line_plots) {
-      if (p.metric == static_cast<int>(m)) a.plots.emplace_back(p.file, LinePlotSvg(p.plot));
+      if (p.metric == static_cast<int>(m)) plots.emplace_back(p.file, LinePlotSvg(p.plot));
     }
-    // A heat map over the first two grid axes.
-    std::vector<std::size_t> grid_axes;
-    for (std::size_t x = 0; x < plan.axes.size(); ++x) {
-      if (!plan.axes[x].sampled) grid_axes.push_back(x);
-    }
-    if (grid_axes.size() >= 2) {
-      const std::size_t ax = grid_axes[0], ay = grid_axes[1];
-      HeatMap map;
-      map.title = metrics[m].name + " (mean) over " + plan.axes[ax].key + " and " +
-                  plan.axes[ay].key;
-      map.x_label = plan.axes[ax].key;
-      map.y_label = plan.axes[ay].key;
-      const std::vector<int> gx = GroupsOf(plan, a.rows, ax, &map.x_values);
-      const std::vector<int> gy = GroupsOf(plan, a.rows, ay, &map.y_values);
-      std::map<std::pair<int, int>, std::vector<double>> cells;
-      for (std::size_t r = 0; r < a.rows.size(); ++r) {
-        cells[{gx[r], gy[r]}].push_back(a.rows[r].metrics[m]);
-      }
-      map.values.assign(map.y_values.size(), std::vector<double>(map.x_values.size(), kNaN));
-      for (const auto& [xy, v] : cells) map.values[xy.second][xy.first] = Describe(v).mean;
-      a.plots.emplace_back(metrics[m].name + "_heatmap.svg", HeatMapSvg(map));
+    if (const std::optional<HeatMap> map = MetricHeatMap(plan, rows, m)) {
+      plots.emplace_back(plan.spec.metrics[m].name + "_heatmap.svg", HeatMapSvg(*map));
     }
   }
+  return plots;
+}
+
+}  // namespace
+
+Aggregate AggregateSweep(const Plan& plan, const fs::path& dir) {
+  Aggregate a;
+  GatherCells(plan, dir, &a);
+  a.summary_csv = SummaryCsv(plan, a.rows);
+  std::vector<VarianceBar> bars;
+  a.variance_csv = VarianceSharesCsv(plan, a.rows, &bars);
+  if (!a.rows.empty()) a.plots = Plots(plan, a.rows, bars);
   return a;
 }
 

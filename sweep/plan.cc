@@ -147,16 +147,13 @@ json NormalizedSpec(const SweepSpec& spec) {
   return j;
 }
 
-Plan BuildPlan(const SweepSpec& spec, const std::string& mmh_version, const fs::path& workdir) {
-  Plan plan;
-  plan.spec = spec;
-  plan.mmh_version = mmh_version;
-  plan.workdir = workdir;
-  plan.inputs = CommandInputs(spec);
-  const std::string file = spec.file.string();
+namespace {
 
-  // The base config and the sets, as the command would read them (a file keeps its name in
-  // messages).
+using Point = std::vector<std::pair<std::string, json>>;  // axis key -> value, axis order
+
+// The base config and the sets, as the command would read them (a file keeps its name in
+// messages).
+Config BaseConfig(const SweepSpec& spec) {
   Config base;
   if (!spec.base_config_file.empty()) {
     base = Config::Load(spec.base_config_file);
@@ -166,57 +163,83 @@ Plan BuildPlan(const SweepSpec& spec, const std::string& mmh_version, const fs::
     }
   }
   for (const auto& set : spec.sets) base.Set(set);
-  json base_resolved;
-  try {
-    base_resolved = ResolveCommandConfig(spec.command, base);
-  } catch (const InputError& e) {
-    throw InputError(file + ": the base config (config and set): " + e.what());
-  }
-  std::vector<std::string> leaves;
-  Leaves(base_resolved, "", &leaves);
+  return base;
+}
 
-  // Each axis key and value alone on the base config: the first error names axis and value.
-  auto check_key = [&](const std::string& key) {
-    const json* value = FindKey(base_resolved, key);
-    if (value && !value->is_object()) return;
-    const std::string suggestion = options_internal::SuggestName(key, leaves);
-    throw InputError(file + ": " + DescribeAxis(spec, key) + ": '" + key + "' is " +
-                     (value ? "a section, not an option," : "not an option") + " of `mmh " +
-                     CommandName(spec.command) + "`" +
-                     (suggestion.empty() ? "" : " (did you mean '" + suggestion + "'?)"));
-  };
-  auto check_value = [&](const std::string& key, const json& value) {
-    Config config = base;
-    config.Set(Assignment(key, value));
-    try {
-      ResolveCommandConfig(spec.command, config);
-    } catch (const InputError& e) {
-      throw InputError(file + ": " + DescribeAxis(spec, key) + " value " + value.dump() + ": " +
-                       e.what());
-    }
-  };
+// The axes as the aggregation sees them: the grid's, then the samples'.
+std::vector<AxisInfo> AxesOf(const SweepSpec& spec) {
+  std::vector<AxisInfo> axes;
   for (const auto& axis : spec.grid) {
-    check_key(axis.key);
-    for (const auto& v : axis.values) check_value(axis.key, v);
     AxisInfo info{axis.key, true, axis.scale, false};
     for (const auto& v : axis.values) info.numeric = info.numeric && v.is_number();
-    plan.axes.push_back(info);
+    axes.push_back(info);
   }
-  for (const auto& axis : spec.samples.axes) {
-    check_key(axis.key);
-    for (double v : {axis.from, axis.to}) {
-      check_value(axis.key, axis.integer ? json(static_cast<long long>(std::round(v))) : json(v));
-    }
-    plan.axes.push_back({axis.key, true, axis.scale, true});
-  }
-  const bool seeded = !spec.replicates.seed_key.empty() &&
-                      (spec.replicates.count > 1 || spec.replicates.scheme == SeedScheme::kPerCell);
-  if (!spec.replicates.seed_key.empty()) check_key(spec.replicates.seed_key);
+  for (const auto& axis : spec.samples.axes) axes.push_back({axis.key, true, axis.scale, true});
+  return axes;
+}
 
-  // Points: the grid (first axis slowest) crossed with the samples.
-  std::vector<std::vector<std::pair<std::string, json>>> points(1);
+// Checks each axis key and value (and the replicates' seed key) alone on the base config: the
+// first error names the spec file, the axis and the value, with the command's "did you mean".
+class AxisChecker {
+ public:
+  AxisChecker(const SweepSpec& spec, const Config& base) : spec_(spec), base_(base) {
+    try {
+      base_resolved_ = ResolveCommandConfig(spec.command, base);
+    } catch (const InputError& e) {
+      throw InputError(File() + ": the base config (config and set): " + e.what());
+    }
+    Leaves(base_resolved_, "", &leaves_);
+  }
+
+  void CheckAll() const {
+    for (const auto& axis : spec_.grid) {
+      CheckKey(axis.key);
+      for (const auto& v : axis.values) CheckValue(axis.key, v);
+    }
+    for (const auto& axis : spec_.samples.axes) {
+      CheckKey(axis.key);
+      for (double v : {axis.from, axis.to}) {
+        CheckValue(axis.key, axis.integer ? json(static_cast<long long>(std::round(v))) : json(v));
+      }
+    }
+    if (!spec_.replicates.seed_key.empty()) CheckKey(spec_.replicates.seed_key);
+  }
+
+ private:
+  std::string File() const { return spec_.file.string(); }
+
+  void CheckKey(const std::string& key) const {
+    const json* value = FindKey(base_resolved_, key);
+    if (value && !value->is_object()) return;
+    const std::string suggestion = options_internal::SuggestName(key, leaves_);
+    throw InputError(File() + ": " + DescribeAxis(spec_, key) + ": '" + key + "' is " +
+                     (value ? "a section, not an option," : "not an option") + " of `mmh " +
+                     CommandName(spec_.command) + "`" +
+                     (suggestion.empty() ? "" : " (did you mean '" + suggestion + "'?)"));
+  }
+
+  void CheckValue(const std::string& key, const json& value) const {
+    Config config = base_;
+    config.Set(Assignment(key, value));
+    try {
+      ResolveCommandConfig(spec_.command, config);
+    } catch (const InputError& e) {
+      throw InputError(File() + ": " + DescribeAxis(spec_, key) + " value " + value.dump() + ": " +
+                       e.what());
+    }
+  }
+
+  const SweepSpec& spec_;
+  const Config& base_;
+  json base_resolved_;
+  std::vector<std::string> leaves_;
+};
+
+// The parameter settings: the grid (first axis slowest) crossed with the samples.
+std::vector<Point> ExpandPoints(const SweepSpec& spec) {
+  std::vector<Point> points(1);
   for (const auto& axis : spec.grid) {
-    std::vector<std::vector<std::pair<std::string, json>>> next;
+    std::vector<Point> next;
     for (const auto& p : points) {
       for (const auto& v : axis.values) {
         next.push_back(p);
@@ -227,7 +250,7 @@ Plan BuildPlan(const SweepSpec& spec, const std::string& mmh_version, const fs::
   }
   if (spec.samples.count > 0) {
     const auto samples = SamplePoints(spec.samples);
-    std::vector<std::vector<std::pair<std::string, json>>> next;
+    std::vector<Point> next;
     for (const auto& p : points) {
       for (const auto& s : samples) {
         next.push_back(p);
@@ -240,48 +263,83 @@ Plan BuildPlan(const SweepSpec& spec, const std::string& mmh_version, const fs::
     }
     points = std::move(next);
   }
-  plan.points = static_cast<int>(points.size());
+  return points;
+}
 
+json PointKey(const Point& point) {
+  json key = json::array();
+  for (const auto& [k, v] : point) key.push_back({k, v});
+  return key;
+}
+
+// Replicate `r` of the setting `point` (number `p`): its config (base, axis values, derived
+// seed), resolved by the command to give its identity.
+Cell MakeCell(const Plan& plan, const Config& base, const Point& point, int p, int r,
+              bool seeded) {
+  const SweepSpec& spec = plan.spec;
+  const json point_key = PointKey(point);
+  Cell cell;
+  cell.point = p;
+  cell.replicate = r;
+  cell.params = point;
+  Config config = base;
+  for (const auto& [k, v] : point) config.Set(Assignment(k, v));
+  if (seeded) {
+    cell.seed = DeriveSeed(spec.replicates, point_key.dump(), r);
+    config.Set(Assignment(spec.replicates.seed_key, *cell.seed));
+  }
+  json resolved;
+  try {
+    resolved = ResolveCommandConfig(spec.command, config);
+  } catch (const InputError& e) {
+    throw InputError(spec.file.string() + ": the cell " + point_key.dump() +
+                     " (a combination of axis values): " + e.what());
+  }
+  cell.config = config.root();
+  cell.id = HashHex(json{{"command", CommandName(spec.command)},
+                         {"inputs", plan.inputs},
+                         {"resolved", resolved},
+                         {"mmh_version", plan.mmh_version}}
+                        .dump());
+  return cell;
+}
+
+// Every replicate of every setting, refusing two cells with one identity.
+void AddCells(const Config& base, const std::vector<Point>& points, Plan* plan) {
+  const SweepSpec& spec = plan->spec;
+  const bool seeded = !spec.replicates.seed_key.empty() &&
+                      (spec.replicates.count > 1 || spec.replicates.scheme == SeedScheme::kPerCell);
   std::map<std::string, std::size_t> ids;
   for (std::size_t p = 0; p < points.size(); ++p) {
-    json point_key = json::array();
-    for (const auto& [k, v] : points[p]) point_key.push_back({k, v});
     for (int r = 0; r < spec.replicates.count; ++r) {
-      Cell cell;
-      cell.point = static_cast<int>(p);
-      cell.replicate = r;
-      cell.params = points[p];
-      Config config = base;
-      for (const auto& [k, v] : points[p]) config.Set(Assignment(k, v));
-      if (seeded) {
-        cell.seed = DeriveSeed(spec.replicates, point_key.dump(), r);
-        config.Set(Assignment(spec.replicates.seed_key, *cell.seed));
-      }
-      json resolved;
-      try {
-        resolved = ResolveCommandConfig(spec.command, config);
-      } catch (const InputError& e) {
-        throw InputError(file + ": the cell " + point_key.dump() + " (a combination of axis "
-                         "values): " + e.what());
-      }
-      cell.config = config.root();
-      cell.id = HashHex(json{{"command", CommandName(spec.command)},
-                             {"inputs", plan.inputs},
-                             {"resolved", resolved},
-                             {"mmh_version", mmh_version}}
-                            .dump());
-      const auto [it, inserted] = ids.emplace(cell.id, plan.cells.size());
+      Cell cell = MakeCell(*plan, base, points[p], static_cast<int>(p), r, seeded);
+      const auto [it, inserted] = ids.emplace(cell.id, plan->cells.size());
       if (!inserted) {
-        const Cell& other = plan.cells[it->second];
-        json other_key = json::array();
-        for (const auto& [k, v] : other.params) other_key.push_back({k, v});
-        ThrowBadValue(file + ": axes", point_key.dump() + " and " + other_key.dump(),
+        ThrowBadValue(spec.file.string() + ": axes",
+                      PointKey(points[p]).dump() + " and " +
+                          PointKey(plan->cells[it->second].params).dump(),
                       "settings that differ: these two resolve to the same config (the same "
                       "cell twice)");
       }
-      plan.cells.push_back(std::move(cell));
+      plan->cells.push_back(std::move(cell));
     }
   }
+}
+
+}  // namespace
+
+Plan BuildPlan(const SweepSpec& spec, const std::string& mmh_version, const fs::path& workdir) {
+  Plan plan;
+  plan.spec = spec;
+  plan.mmh_version = mmh_version;
+  plan.workdir = workdir;
+  plan.inputs = CommandInputs(spec);
+  const Config base = BaseConfig(spec);
+  AxisChecker(spec, base).CheckAll();
+  plan.axes = AxesOf(spec);
+  const std::vector<Point> points = ExpandPoints(spec);
+  plan.points = static_cast<int>(points.size());
+  AddCells(base, points, &plan);
   plan.cells_per_worker = spec.cells_per_worker > 0 ? spec.cells_per_worker
                           : PacksByDefault(spec.command) ? 0  // decided by the backend
                                                          : 1;
@@ -324,12 +382,7 @@ Plan PlanFromJson(const json& j, const fs::path& file) {
     plan.inputs = j.at("inputs").get<std::vector<std::string>>();
     plan.points = j.at("points").get<int>();
     plan.cells_per_worker = j.at("cells_per_worker").get<int>();
-    for (const auto& g : plan.spec.grid) {
-      AxisInfo info{g.key, true, g.scale, false};
-      for (const auto& v : g.values) info.numeric = info.numeric && v.is_number();
-      plan.axes.push_back(info);
-    }
-    for (const auto& s : plan.spec.samples.axes) plan.axes.push_back({s.key, true, s.scale, true});
+    plan.axes = AxesOf(plan.spec);
     for (const auto& c : j.at("cells")) {
       Cell cell;
       cell.id = c.at("id").get<std::string>();

@@ -233,6 +233,145 @@ std::vector<double> ExpandRange(double from, double to, int count, AxisScale sca
   return values;
 }
 
+namespace {
+
+// The base config: a file (read now, so that a missing one is an error before anything runs) or
+// an inline object.
+void ReadBaseConfig(const SpecObject& o, SweepSpec* spec) {
+  if (!o.Has("config")) return;
+  const json& c = o.At("config");
+  if (c.is_string()) {
+    spec->base_config_file = c.get<std::string>();
+    spec->base_config = Config::Load(spec->base_config_file).root();
+  } else if (c.is_object()) {
+    spec->base_config = c;
+  } else {
+    o.Fail("config", c, "a config file (path) or an inline config object");
+  }
+}
+
+// The grid axes and the samples; at least one axis.
+void ReadAxes(const SpecObject& o, const std::string& file, SweepSpec* spec) {
+  if (o.Has("axes")) {
+    const json& axes = o.At("axes");
+    if (!axes.is_array()) o.Fail("axes", axes, "a list of axes");
+    for (std::size_t i = 0; i < axes.size(); ++i) {
+      spec->grid.push_back(ReadGridAxis(axes[i], Indexed("axes", i), file));
+    }
+  }
+  if (o.Has("samples")) spec->samples = ReadSamples(o.At("samples"), file);
+  if (spec->grid.empty() && spec->samples.count == 0) {
+    o.Fail("axes", o.Has("axes") ? o.At("axes") : json(),
+           "at least one axis ('axes' or 'samples'): a sweep over nothing is one plain run");
+  }
+}
+
+// The config keys the sweep varies: each on one axis only (the replicates' seed key included).
+class VariedKeys {
+ public:
+  explicit VariedKeys(const std::string& file) : file_(file) {}
+  void Add(const std::string& key, const std::string& where) {
+    if (!keys_.insert(key).second) {
+      ThrowBadValue(file_ + ": " + where, "\"" + key + "\"", "each config key on one axis only");
+    }
+  }
+
+ private:
+  const std::string& file_;
+  std::set<std::string> keys_;
+};
+
+// The replicates; run and study cells are seeded through population.seed unless the spec names
+// another key.
+void ReadReplicates(const SpecObject& o, const std::string& file, VariedKeys* keys,
+                    SweepSpec* spec) {
+  Replicates& replicates = spec->replicates;
+  if (o.Has("replicates")) {
+    const SpecObject r(o.At("replicates"), "replicates", file, {"count", "seed_key", "seeds", "seed"});
+    replicates.count = static_cast<int>(r.Integer("count", 1, 1, 100000));
+    replicates.seed_key = r.String("seed_key", "");
+    replicates.scheme = r.Choice("seeds", SeedScheme::kPerCell,
+                                 {{SeedScheme::kPerCell, "per_cell"},
+                                  {SeedScheme::kCommon, "common"}});
+    replicates.seed = static_cast<std::uint64_t>(r.Integer("seed", 1, 0, (1ll << 53)));
+    if (!replicates.seed_key.empty()) keys->Add(replicates.seed_key, "replicates.seed_key");
+  }
+  if (replicates.seed_key.empty() &&
+      (spec->command == SweepCommand::kRun || spec->command == SweepCommand::kStudy)) {
+    replicates.seed_key = "population.seed";
+    if (replicates.count > 1) keys->Add(replicates.seed_key, "replicates.seed_key");
+  }
+  if (replicates.count > 1 && replicates.seed_key.empty()) {
+    ThrowBadValue(file + ": replicates.count", std::to_string(replicates.count),
+                  "1 for `mmh " + std::string(CommandName(spec->command)) +
+                      "` (it has no seed; or name one in replicates.seed_key)");
+  }
+}
+
+// metrics[i]: a CSV column name (not in `names`, then added), a file in the command's output
+// folder, a dotted key and the statistics of summary.csv (mean, sd, ci95 unless given).
+Metric ReadMetric(const json& j, std::size_t i, const std::string& file,
+                  std::set<std::string>* names) {
+  const SpecObject m(j, Indexed("metrics", i), file, {"name", "file", "key", "summary"});
+  Metric metric;
+  metric.name = m.String("name", "");
+  metric.file = m.String("file", "");
+  metric.key = m.String("key", "");
+  if (metric.name.empty() || metric.file.empty() || metric.key.empty()) {
+    m.Fail("", j, "{\"name\": column, \"file\": output file, \"key\": dotted path}");
+  }
+  for (char c : metric.name) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) {
+      m.Fail("name", metric.name, "letters, digits and '_' (a CSV column)");
+    }
+  }
+  if (!names->insert(metric.name).second) m.Fail("name", metric.name, "a name used once");
+  if (metric.file.find("..") != std::string::npos || metric.file.front() == '/') {
+    m.Fail("file", metric.file, "a path inside the command's output folder");
+  }
+  if (!m.Has("summary")) {
+    metric.statistics = {Statistic::kMean, Statistic::kSd, Statistic::kCi95};
+    return metric;
+  }
+  if (!m.At("summary").is_array() || m.At("summary").empty()) {
+    m.Fail("summary", m.At("summary"), "a non-empty list of mean, sd, ci95, min, max, median");
+  }
+  for (std::size_t s = 0; s < m.At("summary").size(); ++s) {
+    const json wrapper = {{"s", m.At("summary")[s]}};
+    const SpecObject one(wrapper, m.Path("summary") + "[" + std::to_string(s) + "]", file, {"s"});
+    metric.statistics.push_back(one.Choice("s", Statistic::kMean, kStatistics));
+  }
+  return metric;
+}
+
+void ReadMetrics(const SpecObject& o, const std::string& file, SweepSpec* spec) {
+  if (!o.Has("metrics") || !o.At("metrics").is_array() || o.At("metrics").empty()) {
+    o.Fail("metrics", o.Has("metrics") ? o.At("metrics") : json(),
+           "a non-empty list of metrics ({name, file, key})");
+  }
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < o.At("metrics").size(); ++i) {
+    spec->metrics.push_back(ReadMetric(o.At("metrics")[i], i, file, &names));
+  }
+}
+
+SlurmOptions ReadSlurm(const json& j, const std::string& file) {
+  const SpecObject s(j, "slurm", file,
+                     {"partition", "time", "throttle", "max_array_size", "cells_per_task",
+                      "sbatch_args"});
+  SlurmOptions slurm;
+  slurm.partition = s.String("partition", "");
+  slurm.time_limit = s.String("time", "");
+  slurm.throttle = static_cast<int>(s.Integer("throttle", 0, 0, 1000000));
+  slurm.max_array_size = static_cast<int>(s.Integer("max_array_size", 0, 0, 4000001));
+  if (slurm.max_array_size == 1) s.Fail("max_array_size", 1, "0 (ask Slurm) or >= 2");
+  slurm.cells_per_task = static_cast<int>(s.Integer("cells_per_task", 0, 0, 100000));
+  slurm.sbatch_args = s.Strings("sbatch_args");
+  return slurm;
+}
+
+}  // namespace
+
 SweepSpec ParseSpec(const json& j, const std::filesystem::path& file_path) {
   const std::string file = file_path.string();
   const SpecObject o(j, "", file,
@@ -248,118 +387,24 @@ SweepSpec ParseSpec(const json& j, const std::filesystem::path& file_path) {
                            {SweepCommand::kCompose, "compose"},
                            {SweepCommand::kTrack, "track"}});
   spec.description = o.Has("description") ? o.String("description", "") : "";
-  if (o.Has("config")) {
-    const json& c = o.At("config");
-    if (c.is_string()) {
-      spec.base_config_file = c.get<std::string>();
-      spec.base_config = Config::Load(spec.base_config_file).root();
-    } else if (c.is_object()) {
-      spec.base_config = c;
-    } else {
-      o.Fail("config", c, "a config file (path) or an inline config object");
-    }
-  }
+  ReadBaseConfig(o, &spec);
   spec.sets = o.Strings("set");
   if (o.Has("inputs")) {
     if (!o.At("inputs").is_object()) o.Fail("inputs", o.At("inputs"), "an object");
     spec.inputs = o.At("inputs");
   }
-  if (o.Has("axes")) {
-    const json& axes = o.At("axes");
-    if (!axes.is_array()) o.Fail("axes", axes, "a list of axes");
-    for (std::size_t i = 0; i < axes.size(); ++i) {
-      spec.grid.push_back(ReadGridAxis(axes[i], Indexed("axes", i), file));
-    }
-  }
-  if (o.Has("samples")) spec.samples = ReadSamples(o.At("samples"), file);
-  if (spec.grid.empty() && spec.samples.count == 0) {
-    o.Fail("axes", o.Has("axes") ? o.At("axes") : json(),
-           "at least one axis ('axes' or 'samples'): a sweep over nothing is one plain run");
-  }
-  std::set<std::string> keys;
-  auto unique_key = [&](const std::string& key, const std::string& where) {
-    if (!keys.insert(key).second) {
-      ThrowBadValue(file + ": " + where, "\"" + key + "\"", "each config key on one axis only");
-    }
-  };
+  ReadAxes(o, file, &spec);
+  VariedKeys keys(file);
   for (std::size_t i = 0; i < spec.grid.size(); ++i) {
-    unique_key(spec.grid[i].key, Indexed("axes", i) + ".key");
+    keys.Add(spec.grid[i].key, Indexed("axes", i) + ".key");
   }
   for (std::size_t i = 0; i < spec.samples.axes.size(); ++i) {
-    unique_key(spec.samples.axes[i].key, Indexed("samples.axes", i) + ".key");
+    keys.Add(spec.samples.axes[i].key, Indexed("samples.axes", i) + ".key");
   }
-  if (o.Has("replicates")) {
-    const SpecObject r(o.At("replicates"), "replicates", file, {"count", "seed_key", "seeds", "seed"});
-    spec.replicates.count = static_cast<int>(r.Integer("count", 1, 1, 100000));
-    spec.replicates.seed_key = r.String("seed_key", "");
-    spec.replicates.scheme = r.Choice("seeds", SeedScheme::kPerCell,
-                                      {{SeedScheme::kPerCell, "per_cell"},
-                                       {SeedScheme::kCommon, "common"}});
-    spec.replicates.seed = static_cast<std::uint64_t>(r.Integer("seed", 1, 0, (1ll << 53)));
-    if (!spec.replicates.seed_key.empty()) unique_key(spec.replicates.seed_key, "replicates.seed_key");
-  }
-  if (spec.replicates.seed_key.empty() &&
-      (spec.command == SweepCommand::kRun || spec.command == SweepCommand::kStudy)) {
-    spec.replicates.seed_key = "population.seed";
-    if (spec.replicates.count > 1) unique_key(spec.replicates.seed_key, "replicates.seed_key");
-  }
-  if (spec.replicates.count > 1 && spec.replicates.seed_key.empty()) {
-    ThrowBadValue(file + ": replicates.count", std::to_string(spec.replicates.count),
-                  "1 for `mmh " + std::string(CommandName(spec.command)) +
-                      "` (it has no seed; or name one in replicates.seed_key)");
-  }
-  if (!o.Has("metrics") || !o.At("metrics").is_array() || o.At("metrics").empty()) {
-    o.Fail("metrics", o.Has("metrics") ? o.At("metrics") : json(),
-           "a non-empty list of metrics ({name, file, key})");
-  }
-  std::set<std::string> names;
-  for (std::size_t i = 0; i < o.At("metrics").size(); ++i) {
-    const SpecObject m(o.At("metrics")[i], Indexed("metrics", i), file,
-                       {"name", "file", "key", "summary"});
-    Metric metric;
-    metric.name = m.String("name", "");
-    metric.file = m.String("file", "");
-    metric.key = m.String("key", "");
-    if (metric.name.empty() || metric.file.empty() || metric.key.empty()) {
-      m.Fail("", o.At("metrics")[i], "{\"name\": column, \"file\": output file, \"key\": dotted path}");
-    }
-    for (char c : metric.name) {
-      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) {
-        m.Fail("name", metric.name, "letters, digits and '_' (a CSV column)");
-      }
-    }
-    if (!names.insert(metric.name).second) m.Fail("name", metric.name, "a name used once");
-    if (metric.file.find("..") != std::string::npos || metric.file.front() == '/') {
-      m.Fail("file", metric.file, "a path inside the command's output folder");
-    }
-    if (m.Has("summary")) {
-      if (!m.At("summary").is_array() || m.At("summary").empty()) {
-        m.Fail("summary", m.At("summary"), "a non-empty list of mean, sd, ci95, min, max, median");
-      }
-      for (std::size_t s = 0; s < m.At("summary").size(); ++s) {
-        const json wrapper = {{"s", m.At("summary")[s]}};
-        const SpecObject one(wrapper, m.Path("summary") + "[" + std::to_string(s) + "]", file,
-                             {"s"});
-        metric.statistics.push_back(one.Choice("s", Statistic::kMean, kStatistics));
-      }
-    } else {
-      metric.statistics = {Statistic::kMean, Statistic::kSd, Statistic::kCi95};
-    }
-    spec.metrics.push_back(metric);
-  }
+  ReadReplicates(o, file, &keys, &spec);
+  ReadMetrics(o, file, &spec);
   spec.cells_per_worker = static_cast<int>(o.Integer("cells_per_worker", 0, 0, 100000));
-  if (o.Has("slurm")) {
-    const SpecObject s(o.At("slurm"), "slurm", file,
-                       {"partition", "time", "throttle", "max_array_size", "cells_per_task",
-                        "sbatch_args"});
-    spec.slurm.partition = s.String("partition", "");
-    spec.slurm.time_limit = s.String("time", "");
-    spec.slurm.throttle = static_cast<int>(s.Integer("throttle", 0, 0, 1000000));
-    spec.slurm.max_array_size = static_cast<int>(s.Integer("max_array_size", 0, 0, 4000001));
-    if (spec.slurm.max_array_size == 1) s.Fail("max_array_size", 1, "0 (ask Slurm) or >= 2");
-    spec.slurm.cells_per_task = static_cast<int>(s.Integer("cells_per_task", 0, 0, 100000));
-    spec.slurm.sbatch_args = s.Strings("sbatch_args");
-  }
+  if (o.Has("slurm")) spec.slurm = ReadSlurm(o.At("slurm"), file);
   return spec;
 }
 

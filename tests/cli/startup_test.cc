@@ -108,5 +108,44 @@ TEST(StartupTest, WithoutMmhFullTheLightCommandsStillRunAndTheOthersFailClearly)
       << render.output;
 }
 
+// An installed or moved tree (PREFIX/bin/mmh, mmh-full; PREFIX/lib/mmh/ the plugins, as
+// `cmake --install` lays it out) loads its own plugins, found from the executable's folder: with
+// the plugin removed from the copy, the build tree's (still in place) is not used instead.
+TEST(StartupTest, AMovedTreeLoadsThePluginsBesideItsExecutables) {
+  test_util::TempDir dir;
+  const fs::path prefix = dir.path() / "moved";
+  fs::create_directories(prefix / "bin");
+  fs::create_directories(prefix / "lib" / "mmh");
+  fs::copy_file(MMH_BINARY, prefix / "bin" / "mmh");
+  fs::copy_file(kFull, prefix / "bin" / "mmh-full");
+  const fs::path plugin = fs::path(MMH_BINARY).parent_path() / ".." / "lib" / "mmh" /
+                          "libmmh_oiio_image_io.so";
+  ASSERT_TRUE(fs::exists(plugin)) << plugin;
+  fs::copy_file(plugin, prefix / "lib" / "mmh" / "libmmh_oiio_image_io.so");
+  // A render writes PNGs (OpenImageIO, through the plugin); it runs in the copy's mmh-full.
+  const std::string render = "env -u MMH_PLUGIN_DIR " + (prefix / "bin" / "mmh").string() +
+                             " render --quiet --set render.frames=2 --out ";
+  const auto moved = Shell(render + (dir.path() / "a").string());
+  ASSERT_EQ(moved.exit_code, 0) << moved.output;
+  ASSERT_TRUE(fs::exists(dir.path() / "a" / "depth"));
+  EXPECT_EQ(test_util::ListDir(dir.path() / "a" / "depth").size(), 2u);
+
+  fs::remove(prefix / "lib" / "mmh" / "libmmh_oiio_image_io.so");
+  const auto missing = Shell(render + (dir.path() / "b").string());
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.output.find("cannot load the plugin " +
+                                (prefix / "lib" / "mmh" / "libmmh_oiio_image_io.so").string()),
+            std::string::npos)
+      << missing.output;
+  EXPECT_FALSE(fs::exists(dir.path() / "b" / "depth"));
+
+  // MMH_PLUGIN_DIR names another folder.
+  const auto overridden =
+      Shell("MMH_PLUGIN_DIR=" + plugin.parent_path().string() + " " +
+            (prefix / "bin" / "mmh").string() + " render --quiet --set render.frames=2 --out " +
+            (dir.path() / "c").string());
+  EXPECT_EQ(overridden.exit_code, 0) << overridden.output;
+}
+
 }  // namespace
 }  // namespace mmh

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "sweep/plan.h"
 #include "tests/test_util.h"
 
 extern char** environ;
@@ -292,6 +293,34 @@ TEST_F(SweepCliTest, ASweepKilledWithSigkillResumesWithoutLostOrDuplicatedCells)
                    (temp_ / "clean").string()).exit_code, 0);
   EXPECT_EQ(ReadBytes(dir / "results.csv"), ReadBytes(temp_ / "clean" / "results.csv"));
   EXPECT_EQ(CellOutputs(dir), CellOutputs(temp_ / "clean"));
+}
+
+// Every shipped spec plans (each axis and cell resolved by its command), and the metrics of the
+// `run` specs name keys that mmh run's metrics.json has (the committed full-fidelity baseline
+// run): a misspelt metric would otherwise show only after the whole sweep has run.
+TEST_F(SweepCliTest, ShippedSpecsPlanAndTheirRunMetricsExist) {
+  fs::current_path(MMH_SOURCE_DIR);  // the specs' paths are relative to the project
+  const json metrics = json::parse(
+      ReadBytes(fs::path(MMH_SOURCE_DIR) / "results" / "baseline" / "soldier" / "metrics.json"));
+  int specs = 0, run_metrics = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(MMH_SOURCE_DIR) / "configs" / "sweeps")) {
+    if (entry.path().extension() != ".json") continue;
+    ++specs;
+    const std::string name = entry.path().stem().string();
+    const auto r = RunMmh("sweep --quiet --dry-run --spec " + entry.path().string() + " --out " +
+                          (temp_ / name).string());
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.output;
+    const json spec = json::parse(ReadBytes(entry.path()));
+    if (spec["command"] != "run") continue;
+    for (const json& m : spec["metrics"]) {
+      ++run_metrics;
+      EXPECT_EQ(m["file"], "metrics.json") << name;
+      const json* value = sweep::FindKey(metrics, m["key"].get<std::string>());
+      EXPECT_TRUE(value != nullptr && value->is_number()) << name << ": " << m["key"];
+    }
+  }
+  EXPECT_GE(specs, 6);
+  EXPECT_GE(run_metrics, 17);  // montage_quality's 9 and tracking_noise's 8
 }
 
 }  // namespace
