@@ -475,7 +475,7 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
     md << " " << p.key << " " << Rounded(p.from, 3) << "–" << Rounded(p.to, 3) << ";";
   }
   md << "\n\nPosterior predictive check: " << result.ppc_values.size() << " new studies "
-     << (result.ppc_draws == "posterior" ? "at draws from the posterior (the accepted, adjusted θ)"
+     << (result.ppc_draws == "posterior" ? "at draws from the posterior (the accepted θ, as adjusted)"
                                          : "at the rounded estimate")
      << ".\n";
   md << "\n| statistic | role | paper | predictive median (90 %) | quantile of the paper's |\n"
