@@ -24,6 +24,18 @@ double Quantile(std::vector<double> values, double q) {
   return values[lo] + (h - lo) * (values[hi] - values[lo]);
 }
 
+ParameterPosterior SummarizeColumn(const std::vector<std::vector<double>>& draws, std::size_t j) {
+  std::vector<double> values;
+  for (const auto& theta : draws) values.push_back(theta[j]);
+  ParameterPosterior p;
+  p.median = Quantile(values, 0.5);
+  p.q05 = Quantile(values, 0.05);
+  p.q95 = Quantile(values, 0.95);
+  p.mean = stats::Mean(values);
+  p.sd = values.size() > 1 ? std::sqrt(stats::Variance(values)) : 0;
+  return p;
+}
+
 AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
                        const std::vector<std::pair<int, double>>& fit, const AbcOptions& options,
                        const std::vector<double>& prior_from, const std::vector<double>& prior_to) {
@@ -117,17 +129,71 @@ AbcResult RejectionAbc(const std::vector<Simulation>& simulations,
     }
   }
   for (int j = 0; j < parameters; ++j) {
-    std::vector<double> values;
-    for (const auto& theta : result.accepted_params) values.push_back(theta[j]);
-    ParameterPosterior p;
-    p.median = Quantile(values, 0.5);
-    p.q05 = Quantile(values, 0.05);
-    p.q95 = Quantile(values, 0.95);
-    p.mean = stats::Mean(values);
-    p.sd = values.size() > 1 ? std::sqrt(stats::Variance(values)) : 0;
-    result.posterior.push_back(p);
+    result.posterior.push_back(SummarizeColumn(result.accepted_params, j));
   }
   return result;
+}
+
+std::vector<std::vector<double>> BootstrapMedians(
+    const std::vector<Simulation>& simulations, const std::vector<int>& cell_of,
+    const std::vector<std::pair<int, double>>& fit, const AbcOptions& options,
+    const std::vector<double>& prior_from, const std::vector<double>& prior_to, int draws,
+    std::uint64_t seed) {
+  if (cell_of.size() != simulations.size()) {
+    ThrowBadValue("calibration bootstrap", std::to_string(cell_of.size()) + " cell indices",
+                  "one per simulation (" + std::to_string(simulations.size()) + ")");
+  }
+  int cells = 0;
+  for (int c : cell_of) cells = std::max(cells, c + 1);
+  std::vector<std::vector<int>> members(cells);
+  for (std::size_t i = 0; i < cell_of.size(); ++i) members[cell_of[i]].push_back(static_cast<int>(i));
+  // SplitMix64 (Steele, Lea & Flood 2014): portable, unlike the standard distributions.
+  std::uint64_t state = seed;
+  const auto next = [&state] {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  };
+  std::vector<std::vector<double>> medians;
+  for (int b = 0; b < draws; ++b) {
+    std::vector<Simulation> resample;
+    resample.reserve(simulations.size());
+    for (int c = 0; c < cells; ++c) {
+      const auto pick = static_cast<std::size_t>(next() % static_cast<std::uint64_t>(cells));
+      for (int i : members[pick]) resample.push_back(simulations[i]);
+    }
+    const AbcResult r = RejectionAbc(resample, fit, options, prior_from, prior_to);
+    std::vector<double> m;
+    for (const ParameterPosterior& p : r.posterior) m.push_back(p.median);
+    medians.push_back(std::move(m));
+  }
+  return medians;
+}
+
+std::vector<std::pair<double, double>> NarrowedPrior(
+    const std::vector<std::vector<double>>& accepted_params, const std::vector<double>& prior_from,
+    const std::vector<double>& prior_to, double margin) {
+  if (!(margin >= 0.0) || !std::isfinite(margin)) {
+    ThrowBadValue("calibration.next_round.margin", FormatNumber(margin), "a share >= 0");
+  }
+  std::vector<std::pair<double, double>> box;
+  for (std::size_t j = 0; j < prior_from.size(); ++j) {
+    const double lo_prior = std::min(prior_from[j], prior_to[j]);
+    const double hi_prior = std::max(prior_from[j], prior_to[j]);
+    double lo = hi_prior, hi = lo_prior;
+    for (const auto& theta : accepted_params) {
+      lo = std::min(lo, theta[j]);
+      hi = std::max(hi, theta[j]);
+    }
+    if (accepted_params.empty() || !(hi > lo)) {
+      box.emplace_back(prior_from[j], prior_to[j]);
+      continue;
+    }
+    const double pad = margin * (hi - lo);
+    box.emplace_back(std::max(lo_prior, lo - pad), std::min(hi_prior, hi + pad));
+  }
+  return box;
 }
 
 Sensitivity PriorSensitivity(const std::vector<Simulation>& simulations, int statistics) {

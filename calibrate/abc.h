@@ -14,6 +14,7 @@
 // range. The adjustment removes the part of the posterior's spread that ε lets through.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,6 +57,9 @@ struct AbcResult {
   std::vector<ParameterPosterior> posterior;  // #parameters
 };
 
+// Median, mean, sd and 5 %/95 % quantiles of column j of `draws` ([draw][parameter]).
+ParameterPosterior SummarizeColumn(const std::vector<std::vector<double>>& draws, std::size_t j);
+
 // `fit` lists the statistics (indices into Simulation::values) and their observed values.
 // Simulations missing a fit statistic are never accepted. InputError when fewer than 2 usable
 // simulations remain or the options are invalid.
@@ -75,6 +79,29 @@ struct Sensitivity {
   std::vector<int> samples;                       // simulations with the statistic
 };
 Sensitivity PriorSensitivity(const std::vector<Simulation>& simulations, int statistics);
+
+// How much the estimate (the posterior median) moves when the sweep is run again: the ABC
+// repeated on `draws` bootstrap resamples of the sweep's cells (cells drawn with replacement, each
+// with all its simulations, so replicates at one θ stay together; `cell_of[i]` is simulation i's
+// cell, 0-based and dense). Returns [draw][parameter] medians. The spread of a parameter's medians
+// is the Monte Carlo error of its estimate: small against the posterior's width, the estimate is
+// stable. The resamples come from a 64-bit SplitMix generator seeded with `seed`, so the same
+// inputs give the same draws on every platform.
+std::vector<std::vector<double>> BootstrapMedians(
+    const std::vector<Simulation>& simulations, const std::vector<int>& cell_of,
+    const std::vector<std::pair<int, double>>& fit, const AbcOptions& options,
+    const std::vector<double>& prior_from, const std::vector<double>& prior_to, int draws,
+    std::uint64_t seed);
+
+// The prior of a second, narrower round (sequential ABC with a truncated prior): per parameter,
+// the range of the accepted (adjusted) θ widened by `margin` times that range on each side and
+// kept inside the current prior [from, to]. The second round samples uniformly over it, so its
+// posterior is the first round's posterior restricted to the box, which is the same posterior as
+// long as the box holds all of its mass (the margin's job). A parameter whose accepted values
+// are all equal keeps its current range. Returns {from, to} per parameter.
+std::vector<std::pair<double, double>> NarrowedPrior(
+    const std::vector<std::vector<double>>& accepted_params, const std::vector<double>& prior_from,
+    const std::vector<double>& prior_to, double margin);
 
 // The q-quantile of `values` (type 7 of R's quantile(): linear between order statistics).
 double Quantile(std::vector<double> values, double q);

@@ -90,13 +90,69 @@ TargetCheck Check(const Target& target, const std::vector<double>& values) {
   return c;
 }
 
+constexpr std::pair<PpcDraws, const char*> kPpcDrawsNames[] = {
+    {PpcDraws::kEstimate, "estimate"}, {PpcDraws::kPosterior, "posterior"}};
+
+// The next round's sweep spec: this sweep's spec (as planned) with the sampled axes narrowed to
+// `box`, a new sample seed, and optionally more points or studies per cell.
+nlohmann::json NextRoundSpec(const nlohmann::json& spec, const std::filesystem::path& sweep_dir,
+                             const std::vector<Parameter>& box, const NextRoundOptions& options) {
+  nlohmann::json next = spec;
+  nlohmann::json& samples = next["samples"];
+  for (std::size_t j = 0; j < box.size(); ++j) {
+    samples["axes"][j]["from"] = box[j].from;
+    samples["axes"][j]["to"] = box[j].to;
+  }
+  samples["seed"] = samples.value("seed", std::uint64_t{1}) + 1;
+  if (options.points > 0) samples["count"] = options.points;
+  if (options.replicates > 0) {
+    const std::string assignment = "study.replicates=" + std::to_string(options.replicates);
+    nlohmann::json sets = nlohmann::json::array();
+    if (next.contains("set")) {
+      for (const auto& set : next["set"]) {
+        if (!(set.is_string() && set.get<std::string>().starts_with("study.replicates="))) {
+          sets.push_back(set);
+        }
+      }
+    }
+    sets.push_back(assignment);
+    next["set"] = sets;
+  }
+  next["description"] =
+      "Next calibration round, written by mmh calibrate from the sweep " + sweep_dir.string() +
+      ": the prior narrowed to that round's accepted region (each parameter's accepted range "
+      "widened by " + Num(options.margin) + " of it on each side, inside the previous prior). "
+      "Previous description: " + spec.value("description", std::string());
+  return next;
+}
+
 }  // namespace
+
+std::span<const std::pair<PpcDraws, const char*>> EnumNames(PpcDraws) { return kPpcDrawsNames; }
+
+void NextRoundOptions::Validate(const std::string& prefix) const {
+  if (!(margin >= 0.0 && margin <= 10.0)) {
+    ThrowBadValue(prefix + ".margin", FormatNumber(margin), "a share of the range in [0, 10]");
+  }
+  if (points < 0 || points > 1'000'000) {
+    ThrowBadValue(prefix + ".points", std::to_string(points), "0 (as this sweep) or a count <= 1e6");
+  }
+  if (replicates < 0 || replicates > 100'000) {
+    ThrowBadValue(prefix + ".replicates", std::to_string(replicates),
+                  "0 (as this sweep) or a count <= 100000");
+  }
+}
 
 void CalibrationOptions::Validate(const std::string& prefix) const {
   abc.Validate(prefix + ".abc");
+  next_round.Validate(prefix + ".next_round");
   if (ppc_replicates < 0 || ppc_replicates > 100'000) {
     ThrowBadValue(prefix + ".ppc_replicates", std::to_string(ppc_replicates),
                   "a number of studies in [0, 100000]");
+  }
+  if (bootstrap < 0 || bootstrap > 100'000) {
+    ThrowBadValue(prefix + ".bootstrap", std::to_string(bootstrap),
+                  "a number of resamples in [0, 100000]");
   }
   if (digits < 1 || digits > 17) {
     ThrowBadValue(prefix + ".digits", std::to_string(digits), "an integer in [1, 17]");
@@ -151,6 +207,7 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
     }
     for (auto& row : ReadReplicates(file, result.statistics)) {
       result.simulations.push_back({params, std::move(row)});
+      result.simulation_cell.push_back(result.cells - 1);
     }
   }
   if (result.cells == 0) {
@@ -167,6 +224,12 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
   result.sensitivity =
       PriorSensitivity(result.simulations, static_cast<int>(result.statistics.size()));
   for (const ParameterPosterior& p : result.abc.posterior) result.estimate.push_back(p.median);
+  result.bootstrap_medians = BootstrapMedians(result.simulations, result.simulation_cell, fit,
+                                              options.abc, from, to, options.bootstrap,
+                                              options.bootstrap_seed);
+  for (std::size_t j = 0; j < result.parameters.size() && !result.bootstrap_medians.empty(); ++j) {
+    result.estimate_spread.push_back(SummarizeColumn(result.bootstrap_medians, j));
+  }
   for (const Target& t : targets.targets) {
     const int k = IndexOf(result.statistics, t.statistic);
     std::vector<double> values;
@@ -179,25 +242,48 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
   // The calibrated config: the estimate, rounded, as config sections.
   Config calibrated;
   Config config = Config::Load(sweep::CellConfigPath(sweep_dir, plan.cells.front()));
+  std::vector<double> rounded_estimate;
   for (std::size_t j = 0; j < result.parameters.size(); ++j) {
-    const std::string assignment =
-        result.parameters[j].key + "=" + Rounded(result.estimate[j], options.digits);
+    const std::string value = Rounded(result.estimate[j], options.digits);
+    rounded_estimate.push_back(std::stod(value));
+    const std::string assignment = result.parameters[j].key + "=" + value;
     calibrated.Set(assignment);
     config.Set(assignment);
   }
   result.calibrated_config = calibrated.root();
 
-  // Posterior predictive check: new people and scorers at the estimate.
+  // The next round's prior and spec.
+  const auto box = NarrowedPrior(result.abc.accepted_params, from, to, options.next_round.margin);
+  for (std::size_t j = 0; j < result.parameters.size(); ++j) {
+    result.next_prior.push_back({result.parameters[j].key, box[j].first, box[j].second});
+  }
+  result.next_round_spec =
+      NextRoundSpec(plan.spec.json, sweep_dir, result.next_prior, options.next_round);
+
+  // Posterior predictive check: new people and scorers, at the estimate or at posterior draws.
   config.Set("population.seed=" + std::to_string(options.ppc_seed));
   config.Set("study.seed=" + std::to_string(options.ppc_seed));
   config.Set("run.metrics=false");
   const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
   result.ppc_config = study_config.ToJson();
+  result.ppc_draws = options.ppc_draws == PpcDraws::kPosterior ? "posterior" : "estimate";
   for (int r = 0; r < options.ppc_replicates; ++r) {
-    const study::SimulatedStudy s = study::RunSimulatedStudy(study_config.ForReplicate(r), r);
+    std::vector<double> theta = rounded_estimate;
+    study::StudyConfig draw_config = study_config;
+    if (options.ppc_draws == PpcDraws::kPosterior) {
+      // The accepted draws in order (nearest first), cycling when there are fewer than studies.
+      theta = result.abc.accepted_params[r % result.abc.accepted_params.size()];
+      Config draw = config;
+      for (std::size_t j = 0; j < result.parameters.size(); ++j) {
+        draw.Set(result.parameters[j].key + "=" + Rounded(theta[j], 17));
+      }
+      draw_config = study::StudyConfig::FromConfig(draw);
+    }
+    const study::SimulatedStudy s = study::RunSimulatedStudy(draw_config.ForReplicate(r), r);
     std::vector<std::optional<double>> row;
     for (const auto& statistic : study::ReplicateStatistics(s.analysis)) row.push_back(statistic.value);
     result.ppc_values.push_back(std::move(row));
+    result.ppc_params.push_back(std::move(theta));
     if (progress) progress(r + 1, options.ppc_replicates);
   }
   if (options.ppc_replicates > 0) {
@@ -243,6 +329,22 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
                       {"mean", post.mean}, {"sd", post.sd}, {"q05", post.q05}, {"q95", post.q95}});
   }
   WriteFileAtomically(dir / "parameters.csv", csv);
+
+  // stability.csv: how far the estimate moves over bootstrap resamples of the cells.
+  if (!result.estimate_spread.empty()) {
+    csv = "parameter,estimate,posterior_sd,bootstrap_draws,bootstrap_sd,bootstrap_q05,"
+          "bootstrap_q95,bootstrap_sd_over_posterior_sd\n";
+    for (std::size_t j = 0; j < parameters; ++j) {
+      const ParameterPosterior& post = result.abc.posterior[j];
+      const ParameterPosterior& mc = result.estimate_spread[j];
+      csv += result.parameters[j].key + "," + Num(post.median) + "," + Num(post.sd) + "," +
+             std::to_string(result.bootstrap_medians.size()) + "," + Num(mc.sd) + "," +
+             Num(mc.q05) + "," + Num(mc.q95) + "," +
+             (post.sd > 0 ? Num(mc.sd / post.sd) : std::string()) + "\n";
+      params[j]["bootstrap"] = {{"sd", mc.sd}, {"q05", mc.q05}, {"q95", mc.q95}};
+    }
+    WriteFileAtomically(dir / "stability.csv", csv);
+  }
 
   // posterior.csv: the accepted simulations (distance, parameters as sampled and as adjusted).
   csv = "simulation,distance";
@@ -316,16 +418,19 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
   WriteFileAtomically(dir / "conclusions.csv", csv);
 
   csv = "replicate";
+  for (const Parameter& p : result.parameters) csv += "," + p.key;
   for (const std::string& s : result.statistics) csv += "," + s;
   csv += "\n";
   for (std::size_t r = 0; r < result.ppc_values.size(); ++r) {
     csv += std::to_string(r);
+    for (double v : result.ppc_params[r]) csv += "," + Num(v);
     for (const auto& v : result.ppc_values[r]) csv += "," + (v ? Num(*v) : std::string());
     csv += "\n";
   }
   WriteFileAtomically(dir / "ppc_replicates.csv", csv);
   WriteFileAtomically(dir / "calibrated.json", result.calibrated_config.dump(2) + "\n");
   WriteFileAtomically(dir / "config.resolved.json", result.ppc_config.dump(2) + "\n");
+  WriteFileAtomically(dir / "next_round.json", result.next_round_spec.dump(2) + "\n");
 
   nlohmann::json j;
   j["sweep"] = result.sweep_dir.string();
@@ -340,6 +445,12 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
   j["conclusions"] = conclusions;
   j["identification"] = identification;
   j["calibrated"] = result.calibrated_config;
+  j["ppc_draws"] = result.ppc_draws;
+  nlohmann::json next_prior = nlohmann::json::array();
+  for (const Parameter& p : result.next_prior) {
+    next_prior.push_back({{"key", p.key}, {"prior", {p.from, p.to}}});
+  }
+  j["next_round_prior"] = next_prior;
   WriteFileAtomically(dir / "calibration.json", j.dump(2) + "\n");
 
   // report.md: the tables a reader needs first.
@@ -348,14 +459,25 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
      << result.simulations.size() << " simulated studies (" << result.cells << " cells of "
      << result.sweep_dir.string() << "), " << result.abc.accepted.size()
      << " accepted (distance <= " << Num(result.abc.epsilon) << ").\n\n"
-     << "| parameter | prior | estimate (posterior median) | central 90 % |\n|---|---|---|---|\n";
+     << "| parameter | prior | estimate (posterior median) | central 90 % | estimate's Monte Carlo "
+        "sd (bootstrap of the cells) |\n|---|---|---|---|---|\n";
   for (std::size_t j2 = 0; j2 < parameters; ++j2) {
     const auto& p = result.parameters[j2];
     const auto& post = result.abc.posterior[j2];
     md << "| " << p.key << " | " << Num(p.from) << "–" << Num(p.to) << " | "
        << Rounded(post.median, 3) << " | " << Rounded(post.q05, 3) << "–" << Rounded(post.q95, 3)
+       << " | "
+       << (j2 < result.estimate_spread.size() ? Rounded(result.estimate_spread[j2].sd, 2) : "")
        << " |\n";
   }
+  md << "\nNext round (next_round.json): the prior narrowed to the accepted region:";
+  for (const Parameter& p : result.next_prior) {
+    md << " " << p.key << " " << Rounded(p.from, 3) << "–" << Rounded(p.to, 3) << ";";
+  }
+  md << "\n\nPosterior predictive check: " << result.ppc_values.size() << " new studies "
+     << (result.ppc_draws == "posterior" ? "at draws from the posterior (the accepted θ, as adjusted)"
+                                         : "at the rounded estimate")
+     << ".\n";
   md << "\n| statistic | role | paper | predictive median (90 %) | quantile of the paper's |\n"
         "|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < result.ppc.size(); ++i) {

@@ -10,13 +10,37 @@
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "calibrate/abc.h"
 #include "calibrate/targets.h"
 
 namespace mmh::calibrate {
+
+// Where the posterior predictive studies take the people's parameters from.
+enum class PpcDraws {
+  kEstimate,   // every study at the rounded estimate (the calibrated defaults)
+  kPosterior,  // study r at the r-th accepted (adjusted) θ, cycling: parameter uncertainty included
+};
+std::span<const std::pair<PpcDraws, const char*>> EnumNames(PpcDraws);
+
+// The second round's sweep spec (next_round.json): the prior narrowed by NarrowedPrior.
+struct NextRoundOptions {
+  double margin = 0.1;  // on each side, times the accepted range
+  int points = 0;       // samples.count of the next sweep; 0: this sweep's
+  int replicates = 0;   // studies per cell (study.replicates); 0: this sweep's
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("margin", margin);
+    v("points", points);
+    v("replicates", replicates);
+  }
+  void Validate(const std::string& prefix) const;
+};
 
 // Section "calibration" of `mmh calibrate --set`.
 struct CalibrationOptions {
@@ -26,6 +50,13 @@ struct CalibrationOptions {
   // population.seed and study.seed of the predictive studies (new people, new scorers: not the
   // sweep's, so the check is out of sample).
   std::uint64_t ppc_seed = 2014;
+  // The estimate only, or draws from the posterior (the predictive distribution proper, wider).
+  PpcDraws ppc_draws = PpcDraws::kPosterior;
+  // Bootstrap resamples of the sweep's cells for the estimate's Monte Carlo error (stability.csv;
+  // BootstrapMedians); 0: none. About 2 ms each for 2 400 simulations.
+  int bootstrap = 200;
+  std::uint64_t bootstrap_seed = 2014;
+  NextRoundOptions next_round;
   // Significant digits of the calibrated values written as the config (calibrated.json).
   int digits = 3;
 
@@ -34,6 +65,10 @@ struct CalibrationOptions {
     v("abc", abc);
     v("ppc_replicates", ppc_replicates);
     v("ppc_seed", ppc_seed);
+    v("ppc_draws", ppc_draws);
+    v("bootstrap", bootstrap);
+    v("bootstrap_seed", bootstrap_seed);
+    v("next_round", next_round);
     v("digits", digits);
   }
   void Validate(const std::string& prefix) const;
@@ -72,13 +107,22 @@ struct CalibrationResult {
   int cells = 0;                        // complete cells read
   int incomplete_cells = 0;             // missing or failed (not used)
   std::vector<Simulation> simulations;  // one per replicate of every complete cell
+  std::vector<int> simulation_cell;     // the complete cell (0-based) of each simulation
   AbcResult abc;
   Sensitivity sensitivity;
   std::vector<double> estimate;  // posterior median of each parameter
+  // The estimate's Monte Carlo error: the medians over bootstrap resamples of the cells.
+  std::vector<std::vector<double>> bootstrap_medians;  // [draw][parameter]
+  std::vector<ParameterPosterior> estimate_spread;     // per parameter, over the draws
   std::vector<TargetCheck> accepted_checks;  // the accepted simulations against the targets
   std::vector<TargetCheck> ppc;              // the predictive studies against the targets
   std::vector<ConclusionCheck> conclusions;  // in the predictive studies
   std::vector<std::vector<std::optional<double>>> ppc_values;  // [replicate][statistic]
+  std::vector<std::vector<double>> ppc_params;                 // [replicate][parameter]
+  std::string ppc_draws;                                       // "estimate" or "posterior"
+  // The next round: the narrowed prior and the sweep spec over it (next_round.json).
+  std::vector<Parameter> next_prior;
+  nlohmann::json next_round_spec;
   nlohmann::json calibrated_config;  // the estimate as config sections (rounded)
   nlohmann::json ppc_config;         // the resolved study config of the predictive studies
 };

@@ -52,7 +52,7 @@ void RunCalibrate(const CalibrateArgs& args, const std::vector<std::string>& arg
     std::cout << "written: " << args.common.out_dir
               << "/{report.md, calibration.json, calibrated.json, parameters.csv, posterior.csv, "
                  "identification.csv, targets.csv, conclusions.csv, ppc_replicates.csv, "
-                 "config.resolved.json, run.json}\n";
+                 "config.resolved.json, next_round.json, run.json}\n";
   }
 }
 
@@ -73,7 +73,8 @@ void AddCalibrateCommand(CLI::App& app, const std::vector<std::string>& argv) {
                   "configs/calibration/paper_targets.json)");
   AddCommonFlags(cmd, &args->common,
                  {.config_help = "JSON config with a 'calibration' section (calibration.abc."
-                                 "accept_fraction, ppc_replicates, ppc_seed, digits)"});
+                                 "accept_fraction, ppc_replicates, ppc_seed, ppc_draws, "
+                                 "next_round.margin/points/replicates, digits)"});
   cmd->callback([args, argv] { RunCalibrate(*args, argv); });
 }
 

@@ -237,39 +237,48 @@ StudyData ReadStudyData(const std::filesystem::path& dir, const StudyDataOptions
   return data;
 }
 
-void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
-  // Rankings: unique (animator, item); every animator ranks the same items; ranks valid.
-  std::map<std::string, std::vector<const RankingRow*>> by_animator;
-  std::set<std::string> items;
-  {
-    std::map<std::pair<std::string, std::string>, int> seen;
-    for (const auto& r : data.rankings) {
-      const std::string where = WhereRow(data.rankings_source, r.line);
-      CheckId(r.animator, where + ", column 'animator'");
-      if (r.item != kMontageItem && TakeNumberOfItem(r.item) == 0) {
-        ThrowBadValue(where + ", column 'item'", "'" + r.item + "'", "'montage' or 'take<k>'");
-      }
-      if (!std::isfinite(r.rank)) {
-        ThrowBadValue(where + ", column 'rank'", FormatNumber(r.rank), "a finite rank");
-      }
-      const auto [it, inserted] = seen.emplace(std::make_pair(r.animator, r.item), r.line);
-      if (!inserted) {
-        ThrowBadValue(where,
-                      "a second rank of item '" + r.item + "' by animator '" + r.animator +
-                          "' (first on line " + std::to_string(it->second) + ")",
-                      "one rank per animator and item");
-      }
-      by_animator[r.animator].push_back(&r);
-      items.insert(r.item);
+namespace {
+
+// Each animator's ranking rows, by animator.
+using RowsByAnimator = std::map<std::string, std::vector<const RankingRow*>>;
+
+// Rankings, row by row: ids, items, finite ranks, one rank per (animator, item).
+RowsByAnimator CheckRankingRows(const StudyData& data, std::set<std::string>* items) {
+  RowsByAnimator by_animator;
+  std::map<std::pair<std::string, std::string>, int> seen;
+  for (const auto& r : data.rankings) {
+    const std::string where = WhereRow(data.rankings_source, r.line);
+    CheckId(r.animator, where + ", column 'animator'");
+    if (r.item != kMontageItem && TakeNumberOfItem(r.item) == 0) {
+      ThrowBadValue(where + ", column 'item'", "'" + r.item + "'", "'montage' or 'take<k>'");
     }
+    if (!std::isfinite(r.rank)) {
+      ThrowBadValue(where + ", column 'rank'", FormatNumber(r.rank), "a finite rank");
+    }
+    const auto [it, inserted] = seen.emplace(std::make_pair(r.animator, r.item), r.line);
+    if (!inserted) {
+      ThrowBadValue(where,
+                    "a second rank of item '" + r.item + "' by animator '" + r.animator +
+                        "' (first on line " + std::to_string(it->second) + ")",
+                    "one rank per animator and item");
+    }
+    by_animator[r.animator].push_back(&r);
+    items->insert(r.item);
   }
   if (data.rankings.empty()) {
     ThrowBadValue(data.rankings_source, "no rows", "one row per animator and ranked item");
   }
-  if (items.size() < 2) {
-    ThrowBadValue(data.rankings_source, std::to_string(items.size()) + " ranked item",
+  if (items->size() < 2) {
+    ThrowBadValue(data.rankings_source, std::to_string(items->size()) + " ranked item",
                   "at least 2 items (the takes and the montage)");
   }
+  return by_animator;
+}
+
+// Every animator ranks the same items, and their ranks are 1..K (mid-ranks for ties if allowed).
+void CheckEachAnimatorsRanking(const StudyData& data, const RowsByAnimator& by_animator,
+                               const std::set<std::string>& items,
+                               const StudyDataOptions& options) {
   std::string item_list;
   for (const auto& i : items) item_list += (item_list.empty() ? "" : ", ") + i;
   const double k = static_cast<double>(items.size());
@@ -306,8 +315,10 @@ void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
               : "a permutation of 1.." + FormatNumber(k) + " (set allow_tied_ranks for mid-ranks)");
     }
   }
+}
 
-  // Comparisons: unique (scorer, animator, take); takes 1..K all present.
+// Comparisons: unique (scorer, animator, take); takes 1..K all present.
+void CheckComparisons(const StudyData& data) {
   if (data.comparisons.empty()) {
     ThrowBadValue(data.comparisons_source, "no rows", "one row per binary comparison");
   }
@@ -339,8 +350,11 @@ void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
           "takes numbered 1..K, each compared at least once");
     }
   }
+}
 
-  // Segment costs.
+// Segment costs: finite, the constrained optimum not below the unconstrained, one row per
+// animator of the rankings.
+void CheckSegmentCosts(const StudyData& data, const RowsByAnimator& by_animator) {
   std::map<std::string, int> cost_lines;
   for (const auto& s : data.segment_costs) {
     const std::string where = WhereRow(data.segment_costs_source, s.line);
@@ -372,6 +386,16 @@ void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
                     "one row per animator");
     }
   }
+}
+
+}  // namespace
+
+void ValidateStudyData(const StudyData& data, const StudyDataOptions& options) {
+  std::set<std::string> items;
+  const RowsByAnimator by_animator = CheckRankingRows(data, &items);
+  CheckEachAnimatorsRanking(data, by_animator, items, options);
+  CheckComparisons(data);
+  CheckSegmentCosts(data, by_animator);
 }
 
 std::string RankingsToCsv(const std::vector<RankingRow>& rows) {

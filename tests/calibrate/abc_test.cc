@@ -91,6 +91,62 @@ TEST(AbcTest, SimulationsMissingAFitStatisticAreNeverAccepted) {
             std::string::npos);
 }
 
+// Resampling cells that are all alike cannot move the estimate; different cells do, reproducibly.
+TEST(AbcTest, BootstrapMediansMeasureTheEstimatesMonteCarloError) {
+  // 10 cells of 2 replicates; the summary s = θ + noise, the observed value 0.5.
+  std::vector<Simulation> varied, alike;
+  std::vector<int> cell_of;
+  for (int c = 0; c < 10; ++c) {
+    for (int r = 0; r < 2; ++r) {
+      const double theta = 0.1 * c;
+      varied.push_back({{theta}, {theta + 0.03 * (r == 0 ? 1 : -1) * ((c % 3) - 1)}});
+      alike.push_back({{0.4 + 0.1 * r}, {0.46 + 0.12 * r}});
+      cell_of.push_back(c);
+    }
+  }
+  const AbcOptions options{.accept_fraction = 0.5, .regression_adjustment = false};
+  const auto same = BootstrapMedians(alike, cell_of, {{0, 0.5}}, options, {0}, {1}, 20, 1);
+  ASSERT_EQ(same.size(), 20u);
+  const double full = RejectionAbc(alike, {{0, 0.5}}, options, {0}, {1}).posterior[0].median;
+  for (const auto& m : same) EXPECT_DOUBLE_EQ(m[0], full);
+  const auto a = BootstrapMedians(varied, cell_of, {{0, 0.5}}, options, {0}, {1}, 50, 7);
+  const auto b = BootstrapMedians(varied, cell_of, {{0, 0.5}}, options, {0}, {1}, 50, 7);
+  EXPECT_EQ(a, b);
+  double lo = 1, hi = 0;
+  for (const auto& m : a) lo = std::min(lo, m[0]), hi = std::max(hi, m[0]);
+  EXPECT_GT(hi, lo);
+  EXPECT_NE(ErrorOf([&] { BootstrapMedians(varied, {0, 1}, {{0, 0.5}}, options, {0}, {1}, 5, 1); })
+                .find("one per simulation"),
+            std::string::npos);
+}
+
+// Accepted θ0 in [0.2, 0.4] and θ1 in [0.9, 1.0]: the box is that range ± 10 % of it, cut at the
+// prior; θ2 constant keeps its prior.
+TEST(AbcTest, NarrowedPriorIsTheAcceptedRangeWithAMarginInsideThePrior) {
+  const std::vector<std::vector<double>> accepted = {
+      {0.3, 0.95, 2.0}, {0.2, 1.0, 2.0}, {0.4, 0.9, 2.0}, {0.25, 0.97, 2.0}};
+  const auto box = NarrowedPrior(accepted, {0.0, 0.0, 1.0}, {1.0, 1.0, 3.0}, 0.1);
+  ASSERT_EQ(box.size(), 3u);
+  EXPECT_NEAR(box[0].first, 0.18, 1e-12);
+  EXPECT_NEAR(box[0].second, 0.42, 1e-12);
+  EXPECT_NEAR(box[1].first, 0.89, 1e-12);
+  EXPECT_DOUBLE_EQ(box[1].second, 1.0);  // 1.01 cut at the prior's bound
+  EXPECT_EQ(box[2], std::make_pair(1.0, 3.0));
+  // Every accepted value lies in its box (margin 0: exactly the range).
+  const auto tight = NarrowedPrior(accepted, {0.0, 0.0, 1.0}, {1.0, 1.0, 3.0}, 0.0);
+  for (const auto& theta : accepted) {
+    for (std::size_t j = 0; j < theta.size(); ++j) {
+      EXPECT_GE(theta[j], tight[j].first);
+      EXPECT_LE(theta[j], tight[j].second);
+    }
+  }
+  EXPECT_DOUBLE_EQ(tight[0].first, 0.2);
+  EXPECT_DOUBLE_EQ(tight[0].second, 0.4);
+  EXPECT_NE(ErrorOf([&] { NarrowedPrior(accepted, {0, 0, 1}, {1, 1, 3}, -0.1); })
+                .find("calibration.next_round.margin"),
+            std::string::npos);
+}
+
 // s0 = 2 θ0 exactly: standardised coefficient 1 on θ0, 0 on θ1, R² 1; s1 = θ1²: θ1 alone.
 TEST(AbcTest, PriorSensitivityFindsWhichParameterMovesWhichStatistic) {
   std::vector<Simulation> sims;
