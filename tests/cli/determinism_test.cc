@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <functional>
 #include <map>
-#include <ostream>
 #include <nlohmann/json.hpp>
+#include <ostream>
 #include <set>
 #include <string>
 #include <vector>
@@ -53,7 +53,8 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 // `text` with every OUT replaced by `out`.
 std::string WithOut(std::string text, const std::string& out) {
-  for (size_t at = text.find("OUT"); at != std::string::npos; at = text.find("OUT", at + out.size())) {
+  for (size_t at = text.find("OUT"); at != std::string::npos;
+       at = text.find("OUT", at + out.size())) {
     text.replace(at, 3, out);
   }
   return text;
@@ -141,9 +142,8 @@ TEST_P(DeterminismTest, SameBytesAcrossRunsAndThreadCounts) {
     ASSERT_FALSE(snapshots.back().empty()) << command;
   }
   for (size_t k = 1; k < snapshots.size(); ++k) {
-    EXPECT_EQ(snapshots[0] == snapshots[k], true)
-        << "run 1 (" << variants[0] << ") and run " << k + 1 << " (" << variants[k]
-        << ") differ:\n"
+    EXPECT_TRUE(snapshots[0] == snapshots[k])
+        << "run 1 (" << variants[0] << ") and run " << k + 1 << " (" << variants[k] << ") differ:\n"
         << Differences(snapshots[0], snapshots[k]);
   }
 }
@@ -169,16 +169,17 @@ void WriteText(const fs::path& path, const json& j) { test_util::WriteText(path,
 
 // A sweep spec of 4 compose cells.
 json ComposeSweepSpec() {
-  return {{"command", "compose"},
-          {"inputs",
-           {{"takes", {kStory + "take_1.tum", kStory + "take_2.tum", kStory + "take_3.tum"}},
-            {"annotations", {kStory + "take_1.csv", kStory + "take_2.csv", kStory + "take_3.csv"}}}},
-          {"axes",
-           {{{"key", "montage.labelling.mu"}, {"values", {10, 1000}}},
-            {{"key", "montage.labelling.min_segment_length"}, {"values", {0, 60}}}}},
-          {"metrics",
-           {{{"name", "total_cost"}, {"file", "summary.json"}, {"key", "total_cost"}},
-            {{"name", "segments"}, {"file", "summary.json"}, {"key", "segments"}}}}};
+  return {
+      {"command", "compose"},
+      {"inputs",
+       {{"takes", {kStory + "take_1.tum", kStory + "take_2.tum", kStory + "take_3.tum"}},
+        {"annotations", {kStory + "take_1.csv", kStory + "take_2.csv", kStory + "take_3.csv"}}}},
+      {"axes",
+       {{{"key", "montage.labelling.mu"}, {"values", {10, 1000}}},
+        {{"key", "montage.labelling.min_segment_length"}, {"values", {0, 60}}}}},
+      {"metrics",
+       {{{"name", "total_cost"}, {"file", "summary.json"}, {"key", "total_cost"}},
+        {{"name", "segments"}, {"file", "summary.json"}, {"key", "segments"}}}}};
 }
 
 const std::vector<Case>& Cases() {
@@ -213,14 +214,16 @@ const std::vector<Case>& Cases() {
       {.name = "render",
        .prepare =
            [](const fs::path&) {
-             return std::string("render --set render.frames=20 --set render.fakenect=true "
-                                "--set render.bop=true --out OUT");
+             return std::string(
+                 "render --set render.frames=20 --set render.fakenect=true "
+                 "--set render.bop=true --out OUT");
            },
        .skip = {"run.json", "render_summary.json"}},
       {.name = "run",
        .prepare =
            [](const fs::path&) {
-             return "run --config " + kSource + "/configs/soldier.json --set render.frames=61 --out OUT";
+             return "run --config " + kSource +
+                    "/configs/soldier.json --set render.frames=61 --out OUT";
            },
        .skip = {"run.json", "timings.csv"}},
       {.name = "study", .prepare = [](const fs::path&) { return kStudy + " --out OUT"; }},
@@ -242,8 +245,8 @@ const std::vector<Case>& Cases() {
            [](const fs::path& in) {
              RenderTake(in);
              const fs::path take = in / "take";
-             MustRun("track --input " + take.string() + " --model " + (take / "model.ply").string() +
-                     " --out " + (in / "tracked").string());
+             MustRun("track --input " + take.string() + " --model " +
+                     (take / "model.ply").string() + " --out " + (in / "tracked").string());
              return "eval --input " + take.string() + " --model " + (take / "model.ply").string() +
                     " --estimate " + (in / "tracked" / "trajectory.tum").string() + " --out OUT";
            },
@@ -314,24 +317,23 @@ const std::vector<Case>& Cases() {
            [](const fs::path& in) {
              // Four cells of one parameter, 2 studies of 5 animators each (as
              // tests/calibrate/calibrate_cli_test.cc).
-             WriteText(in / "spec.json",
-                       {{"command", "study"},
-                        {"config", kSource + "/configs/study_soldier.json"},
-                        {"set",
-                         {"run.fidelity=\"fast\"", "run.metrics=false", "study.replicates=2",
-                          "study.animators=5"}},
-                        {"samples",
-                         {{"method", "latin_hypercube"},
-                          {"count", 4},
-                          {"seed", 7},
-                          {"axes",
-                           {{{"key", "viewer.judgement_noise"}, {"from", 0.02}, {"to", 0.4}}}}}},
-                        {"metrics",
-                         {{{"name", "h1_mean_m"},
-                           {"file", "results.json"},
-                           {"key", "analysis.h1.mean_m"}}}}});
-             WriteText(in / "targets.json",
-                       json::parse(R"({"targets": [
+             WriteText(
+                 in / "spec.json",
+                 {{"command", "study"},
+                  {"config", kSource + "/configs/study_soldier.json"},
+                  {"set",
+                   {"run.fidelity=\"fast\"", "run.metrics=false", "study.replicates=2",
+                    "study.animators=5"}},
+                  {"samples",
+                   {{"method", "latin_hypercube"},
+                    {"count", 4},
+                    {"seed", 7},
+                    {"axes", {{{"key", "viewer.judgement_noise"}, {"from", 0.02}, {"to", 0.4}}}}}},
+                  {"metrics",
+                   {{{"name", "h1_mean_m"},
+                     {"file", "results.json"},
+                     {"key", "analysis.h1.mean_m"}}}}});
+             WriteText(in / "targets.json", json::parse(R"({"targets": [
                          {"statistic": "h1_mean_m", "value": 0.65, "role": "fit"},
                          {"statistic": "h3_f", "value": 0.83, "role": "holdout"}]})"));
              MustRun("sweep --jobs 2 --spec " + (in / "spec.json").string() + " --out " +
@@ -355,7 +357,9 @@ const std::vector<Case>& Cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(EverySubcommand, DeterminismTest, ::testing::ValuesIn(Cases()),
-                         [](const ::testing::TestParamInfo<Case>& info) { return info.param.name; });
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return info.param.name;
+                         });
 
 }  // namespace
 }  // namespace mmh
