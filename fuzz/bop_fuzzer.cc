@@ -23,6 +23,12 @@ const std::filesystem::path& Scene() {
 
 }  // namespace
 
+// Once, before the first input: the frames are made (and the image readers started) here.
+extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
+  Scene();
+  return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace mmh;
   const std::filesystem::path& scene = Scene();

@@ -410,6 +410,32 @@ fs::path CellConfigPath(const fs::path& dir, const Cell& cell) {
   return dir / "configs" / (cell.id + ".json");
 }
 
+namespace {
+
+// WriteFileAtomically's temporary (NAME.tmp.PID.N) of a writer that was killed.
+bool IsTemporary(const fs::path& file) {
+  return file.filename().string().find(".tmp.") != std::string::npos;
+}
+
+// Whether `dir` holds only what WritePlan writes before plan.json: configs/ with cell configs
+// (and temporaries of a killed writer). Such a folder is a sweep killed while writing its plan,
+// and is continued: refusing it would leave the user a folder no rerun accepts.
+bool OnlyAnUnfinishedPlan(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (IsTemporary(e.path()) && e.is_regular_file()) continue;
+    if (e.path().filename() != "configs" || !e.is_directory()) return false;
+  }
+  if (!fs::exists(dir / "configs")) return true;
+  for (const auto& e : fs::directory_iterator(dir / "configs")) {
+    if (!e.is_regular_file() || (e.path().extension() != ".json" && !IsTemporary(e.path()))) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 void WritePlan(const fs::path& dir, const Plan& plan) {
   const fs::path plan_file = dir / "plan.json";
   const json now = PlanToJson(plan);
@@ -439,14 +465,16 @@ void WritePlan(const fs::path& dir, const Plan& plan) {
                        earlier.value("spec_file", std::string("?")) + "); keys that differ: " +
                        keys + ". Use another --out, or the same spec to continue that sweep");
     }
-  } else if (fs::exists(dir) && !fs::is_empty(dir)) {
+  } else if (fs::exists(dir) && !fs::is_empty(dir) && !OnlyAnUnfinishedPlan(dir)) {
     ThrowBadValue("--out " + dir.string(), "a non-empty folder without plan.json",
                   "a new or empty folder, or the folder of an earlier sweep of this spec");
   }
+  const bool continued = fs::exists(plan_file);
   EnsureDirectory(dir / "configs");
   for (const auto& cell : plan.cells) {
+    // Without a plan.json, configs of a killed writer are not trusted: all are written again.
     const fs::path path = CellConfigPath(dir, cell);
-    if (!fs::exists(path)) WriteFileAtomically(path, cell.config.dump(2) + "\n");
+    if (!continued || !fs::exists(path)) WriteFileAtomically(path, cell.config.dump(2) + "\n");
   }
   // Written last: a plan.json means every config beside it is in place.
   WriteFileAtomically(plan_file, now.dump(1) + "\n");

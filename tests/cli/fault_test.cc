@@ -1,6 +1,6 @@
-// Faults: `render`, `run` and `study` killed with SIGKILL at several moments never leave a partial
-// file under a final name, and a rerun (or `run --resume`) completes with the same bytes as an
-// uninterrupted run. Also the thread count: --threads 1 and 2 give the same bytes.
+// Faults: `render`, `run`, `study` and `sweep` killed with SIGKILL at several moments never leave
+// a partial file under a final name, and a rerun (or `run --resume`) completes with the same bytes
+// as an uninterrupted run. (The thread count and reruns of every subcommand: determinism_test.cc.)
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -168,32 +168,29 @@ TEST_F(FaultTest, StudyKilledLeavesNothingPartialAndARerunGivesTheSameBytes) {
                 {100, 400, 1200}});
 }
 
-// Same bytes for --threads 1 and 2 (and across runs: the reference of the kill tests), but the
-// files of timings and work counts (render_summary.json's rays depend on the thread count).
-TEST_F(FaultTest, ThreadCountDoesNotChangeTheBytes) {
-  TempDir dir;
-  const std::string src = MMH_SOURCE_DIR;
-  const std::vector<std::pair<std::string, std::set<std::string>>> commands = {
-      {"render --set render.frames=20", {"run.json", "render_summary.json"}},
-      {"study --config " + src +
-           "/configs/study_soldier.json --set run.fidelity=fast --set study.animators=6",
-       {"run.json"}},
-      {"run --config " + src + "/configs/soldier.json --set render.frames=61",
-       {"run.json", "timings.csv"}},
-  };
-  for (const auto& [command, timings] : commands) {
-    SCOPED_TRACE(command);
-    const fs::path a = dir / "a", b = dir / "b";
-    const auto ra = RunMmh(command + " --threads 1 --quiet --out " + a.string());
-    ASSERT_EQ(ra.exit_code, 0) << ra.output;
-    const auto rb = RunMmh(command + " --threads 2 --quiet --out " + b.string());
-    ASSERT_EQ(rb.exit_code, 0) << rb.output;
-    const auto ca = Contents(a, timings);
-    EXPECT_FALSE(ca.empty());
-    EXPECT_EQ(ca, Contents(b, timings));
-    fs::remove_all(a);
-    fs::remove_all(b);
+// A sweep continues when run again (cells whose status says done are skipped): killed while its
+// cells run, a rerun completes to the bytes of an uninterrupted sweep.
+TEST_F(FaultTest, SweepKilledContinuesToTheSameBytes) {
+  TempDir spec_dir;
+  const std::string story = std::string(MMH_SOURCE_DIR) + "/examples/synthetic_story/take_";
+  std::string takes, annotations;
+  for (int k = 1; k <= 3; ++k) {
+    takes += std::string(k > 1 ? ", " : "") + "\"" + story + std::to_string(k) + ".tum\"";
+    annotations += std::string(k > 1 ? ", " : "") + "\"" + story + std::to_string(k) + ".csv\"";
   }
+  // 9 compose cells.
+  const fs::path spec = spec_dir / "spec.json";
+  test_util::WriteText(spec, R"({"command": "compose", "inputs": {"takes": [)" + takes +
+                                 R"(], "annotations": [)" + annotations + R"(]},
+    "axes": [{"key": "montage.labelling.mu", "values": [10, 100, 1000]},
+             {"key": "montage.labelling.min_segment_length", "values": [0, 30, 60]}],
+    "metrics": [{"name": "total_cost", "file": "summary.json", "key": "total_cost"}]})");
+  KillAndRerun({"sweep",
+                "sweep --jobs 2 --threads 2 --spec " + spec.string(),
+                "",
+                {"run.json", "provenance.json"},
+                {150, 600, 1500},
+                /*whole_folder=*/false});
 }
 
 }  // namespace

@@ -185,6 +185,26 @@ TEST_F(SweepCliTest, BadInputIsExitTwoNamingSpecAxisAndValueAndWritesNothing) {
   r = RunMmh("sweep --dry-run --spec " + good.string() + " --out " + (temp_ / "foreign").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("a non-empty folder without plan.json"), std::string::npos) << r.output;
+  // A sweep killed while writing its plan (configs/ before plan.json) is continued, its configs
+  // written again; a configs/ folder holding anything else is still refused.
+  fs::create_directories(temp_ / "killed" / "configs");
+  test_util::WriteText(temp_ / "killed" / "configs" / "0123456789abcdef.json", "{\"cut");
+  test_util::WriteText(temp_ / "killed" / "configs" / "x.json.tmp.99.0", "{");
+  test_util::WriteText(temp_ / "killed" / "plan.json.tmp.99.1", "{");
+  r = RunMmh("sweep --dry-run --quiet --spec " + good.string() + " --out " +
+             (temp_ / "killed").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(temp_ / "killed" / "plan.json"));
+  for (const auto& e : fs::directory_iterator(temp_ / "killed" / "configs")) {
+    const std::string name = e.path().filename().string();
+    if (name.find(".tmp.") != std::string::npos || name == "0123456789abcdef.json") continue;
+    EXPECT_NO_THROW(json::parse(ReadBytes(e.path()))) << name;
+  }
+  fs::create_directories(temp_ / "foreign" / "configs");
+  test_util::WriteText(temp_ / "foreign" / "configs" / "notes.txt", "mine");
+  fs::remove(temp_ / "foreign" / "notes.txt");
+  r = RunMmh("sweep --dry-run --spec " + good.string() + " --out " + (temp_ / "foreign").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
   ASSERT_EQ(RunMmh("sweep --dry-run --spec " + good.string() + " --out " +
                    (temp_ / "s").string()).exit_code, 0);
   spec = ComposeSpec();
