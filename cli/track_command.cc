@@ -62,6 +62,9 @@ void RunTrack(const TrackArgs& args, const std::vector<std::string>& argv) {
   const pipeline::TrackFolderResult result =
       pipeline::TrackToFolder(args.inputs, track_config, out, options);
   progress_bar.Finish();
+  for (const std::string& warning : result.run.summary.warnings) {
+    std::cerr << "warning: " << warning << "\n";
+  }
   if (!args.common.quiet) PrintTrack(out, result, track_config);
   // Failures of the work, not of the input's form (exit 1): status.csv says why.
   if (!track_config.track.proxy) {

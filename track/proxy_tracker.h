@@ -247,6 +247,9 @@ struct TrackFrameResult {
   double rms = 0.0;                   // [m]
   double free_space_violation = 0.0;  // share
   int iterations = 0;
+  // Wall-clock time the run spent on this frame [s]: tracking (or the detection) and the slider,
+  // not reading the frame. Written by RunTracking; a timing, so it differs between runs.
+  double seconds = 0.0;
 };
 
 class ProxyTracker {

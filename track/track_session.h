@@ -111,6 +111,9 @@ struct TrackSummary {
   double seconds = 0.0;  // tracking and slider reading, reading frames excluded
   // "detection", or "truth" when the first pose came from the ground truth.
   std::string init = "detection";
+  // What may make the run miss the object although the input is valid (MinHeightWarning); in
+  // track_summary.json as "warnings" when there are any.
+  std::vector<std::string> warnings;
   nlohmann::json ToJson() const;
 };
 
@@ -137,6 +140,19 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
                      const TrackSetup& setup, bool setup_calibrated, const TrackConfig& config,
                      const std::function<void(int, int)>& progress = {},
                      const std::optional<Rigid3>& initial_camera_T_proxy = std::nullopt);
+
+// The model's smallest width [m]: the least extent of its vertices along any direction (1 000
+// directions on a Fibonacci sphere; the smallest of the bounding box's three extents in the
+// model's own axes is an upper bound on it). Lying on its flattest side, the object stands this
+// high above the table.
+double SmallestWidth(const TriangleMesh& model);
+
+// The warning for a segmentation that cuts the object off: the segmentation keeps only points
+// more than tracker.segmentation.min_height above the table, so an object whose smallest width is
+// less than min_height + kMinVisibleHeight (1 cm: too few points above the cut for the inlier
+// share) is hidden or nearly so lying on its flattest side. Empty when the model stands clear.
+std::string MinHeightWarning(double smallest_width, double min_height);
+inline constexpr double kMinVisibleHeight = 0.01;
 
 // Writes status.csv, annotation.csv (when the slider was read), trajectory.tum (when any frame
 // was not lost) and track_summary.json into `out` (created), each atomically. Returns the names

@@ -5,7 +5,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <sstream>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "core/tum_io.h"
@@ -29,25 +32,29 @@ struct Scores {
   double median_rotation_deg, median_translation_mm, recall_5deg_5cm, ar;
 };
 
-Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, const std::string& init) {
+// `model` under tests/data/real/ycbv (models/: the fitted cuboids; models_real/: the hulls of the
+// dataset's own model points), `video` a folder of it, `extra` more flags for `mmh track`.
+Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, const std::string& init,
+                    const fs::path& video = kVideo, const std::string& extra = "") {
   const fs::path out = dir / ("track_" + init + std::to_string(object));
-  const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
-                            (kReal / "models" / model).string() + " --config " + kPreset +
+  const auto track = RunMmh("track --quiet --input " + video.string() + " --model " +
+                            (kReal / model).string() + " --config " + kPreset +
                             " --set track.object=" + std::to_string(object) +
-                            " --set track.init=\\\"" + init + "\\\" --out " + out.string());
+                            " --set track.init=\\\"" + init + "\\\" " + extra + " --out " +
+                            out.string());
   EXPECT_EQ(track.exit_code, 0) << track.output;
   const auto summary = nlohmann::json::parse(ReadBytes(out / "track_summary.json"));
   EXPECT_EQ(summary["init"], init);
   EXPECT_TRUE(fs::exists(out / "groundtruth.tum"));
   const fs::path eval = dir / ("eval_" + init + std::to_string(object));
-  const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model " +
-                             (kReal / "models" / model).string() + " --estimate " +
+  const auto result = RunMmh("eval --quiet --input " + video.string() + " --model " +
+                             (kReal / model).string() + " --estimate " +
                              (out / "trajectory.tum").string() + " --set track.object=" +
                              std::to_string(object) + " --out " + eval.string());
   EXPECT_EQ(result.exit_code, 0) << result.output;
   const auto json = nlohmann::json::parse(ReadBytes(eval / "eval.json"));
   const auto& o = json["objects"][0];
-  EXPECT_EQ(o["frames"], 10);
+  EXPECT_EQ(o["frames"], video == kVideo ? 10 : 1);
   EXPECT_FALSE(o["ar_vsd"].is_null());
   return {o["median_rotation_deg"], o["median_translation_mm"], o["recall_5deg_5cm"], o["ar"]};
 }
@@ -55,7 +62,8 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
 TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromTheTruthsFirstPose) {
   TempDir dir;
   for (const auto& [object, model] :
-       {std::pair<int, std::string>{8, "009_gelatin_box.obj"}, {21, "061_foam_brick.obj"}}) {
+       {std::pair<int, std::string>{8, "models/009_gelatin_box.obj"},
+        {21, "models/061_foam_brick.obj"}}) {
     SCOPED_TRACE(model);
     const Scores truth = TrackAndEval(dir, object, model, "truth");
     // Measured 1.13 deg / 1.71 mm (box) and 2.52 deg / 1.97 mm (brick), all 10 frames within
@@ -75,12 +83,12 @@ TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
   // frames within 5 deg / 5 cm, AR 1.0 and 0.979 (docs/tracker.md). The goals: median
   // <= 2 deg, <= 5 mm, >= 90 % within 5 deg / 5 cm; the brick's rotation misses the 2 deg by the
   // cuboid model's bias (2.47 deg from the truth's first pose too).
-  const Scores box = TrackAndEval(dir, 8, "009_gelatin_box.obj", "detection");
+  const Scores box = TrackAndEval(dir, 8, "models/009_gelatin_box.obj", "detection");
   EXPECT_LT(box.median_rotation_deg, 2.0);
   EXPECT_LT(box.median_translation_mm, 5.0);
   EXPECT_GE(box.recall_5deg_5cm, 0.9);
   EXPECT_GE(box.ar, 0.9);
-  const Scores brick = TrackAndEval(dir, 21, "061_foam_brick.obj", "detection");
+  const Scores brick = TrackAndEval(dir, 21, "models/061_foam_brick.obj", "detection");
   EXPECT_LT(brick.median_rotation_deg, 3.5);
   EXPECT_LT(brick.median_translation_mm, 5.0);
   EXPECT_GE(brick.recall_5deg_5cm, 0.9);
@@ -91,6 +99,16 @@ TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
   std::string both = ReadBytes(dir / "track_detection8" / "results_bop.csv");
   const std::string brick_results = ReadBytes(dir / "track_detection21" / "results_bop.csv");
   both += brick_results.substr(brick_results.find('\n') + 1);
+  // Each line's time is the frame's own tracking time (seconds, measured): positive, the first
+  // frame's (the detection) the longest.
+  std::vector<double> times;
+  std::istringstream lines(brick_results);
+  std::string line;
+  std::getline(lines, line);
+  while (std::getline(lines, line)) times.push_back(std::stod(line.substr(line.rfind(',') + 1)));
+  ASSERT_EQ(times.size(), 10u);
+  for (double t : times) EXPECT_GT(t, 0.0);
+  EXPECT_EQ(std::max_element(times.begin(), times.end()) - times.begin(), 0);
   WriteText(dir / "both.csv", both);
   const auto result = RunMmh("eval --quiet --input " + kVideo.string() + " --model 8=" +
                              (kReal / "models" / "009_gelatin_box.obj").string() + " --model 21=" +
@@ -104,6 +122,61 @@ TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
   EXPECT_EQ(json["overall"]["frames"], 20);
   EXPECT_NEAR(json["overall"]["ar"].get<double>(), (box.ar + brick.ar) / 2, 1e-9);
   EXPECT_TRUE(fs::exists(dir / "both" / "eval_overall.csv"));
+}
+
+// The hulls of the dataset's own model points (models_real/, PROVENANCE.md) instead of the fitted
+// cuboids, from the truth's first pose. Measured: gelatin box 1.54 deg / 0.89 mm, AR 1.0; foam
+// brick 2.46 deg / 1.41 mm, AR 0.990 (the cuboid: 2.47 deg / 1.97 mm, AR 0.978): the brick's
+// 2.5 deg stays with the real shape (docs/tracker.md, "The sim-to-real gap").
+TEST(RealRecordingCliTest, TracksYcbVideoObjectsWithTheirRealModelPoints) {
+  TempDir dir;
+  const Scores box = TrackAndEval(dir, 8, "models_real/009_gelatin_box.obj", "truth");
+  EXPECT_LT(box.median_rotation_deg, 2.5);
+  EXPECT_LT(box.median_translation_mm, 2.5);
+  EXPECT_GE(box.ar, 0.95);
+  const Scores brick = TrackAndEval(dir, 21, "models_real/061_foam_brick.obj", "truth");
+  EXPECT_LT(brick.median_rotation_deg, 3.5);
+  EXPECT_LT(brick.median_translation_mm, 2.5);
+  EXPECT_GE(brick.recall_5deg_5cm, 0.9);
+  EXPECT_GE(brick.ar, 0.95);
+}
+
+// A can (a cylinder: continuous symmetry about its axis, models_real/models_info.json) found by
+// the tracker's own detection on a real frame among a sugar box, a meat can and a pitcher.
+// Measured 1.84 deg / 2.40 mm, AR 0.967. The table check is widened to 2 cm: on this frame the
+// dataset's own truth puts the can's bottom 10.6 mm below the table plane that the table's pixels
+// beside it confirm to 1 mm (docs/tracker.md), and the 1 cm default rejects the true pose.
+TEST(RealRecordingCliTest, FindsACanOnARealFrameFromItsOwnDetection) {
+  TempDir dir;
+  const Scores can = TrackAndEval(dir, 1, "models_real/002_master_chef_can.obj", "detection",
+                                  kReal / "data" / "unnamed_can",
+                                  "--set tracker.verification.max_penetration=0.02");
+  EXPECT_LT(can.median_rotation_deg, 4.0);
+  EXPECT_LT(can.median_translation_mm, 5.0);
+  EXPECT_EQ(can.recall_5deg_5cm, 1.0);
+  EXPECT_GE(can.ar, 0.9);
+  // With the default table check the true pose is refused, as the test's comment says.
+  const auto strict = RunMmh("track --quiet --input " + (kReal / "data" / "unnamed_can").string() +
+                             " --model " + (kReal / "models_real" / "002_master_chef_can.obj").string() +
+                             " --config " + kPreset + " --set track.object=1 --set track.init=\\\"truth\\\" --out " +
+                             (dir / "strict").string());
+  EXPECT_NE(strict.exit_code, 0);
+  EXPECT_THAT(ReadBytes(dir / "strict" / "status.csv"), HasSubstr("into the table"));
+}
+
+// The real preset's 3 cm cut would hide the gelatin box (27 mm thin) lying flat: `mmh track` warns
+// on stderr and in track_summary.json, naming the option and the thickness; the run goes on.
+TEST(RealRecordingCliTest, WarnsWhenTheMinHeightHidesTheModelLyingFlat) {
+  TempDir dir;
+  const auto track = RunMmh("track --quiet --input " + kVideo.string() + " --model " +
+                            (kReal / "models" / "009_gelatin_box.obj").string() + " --config " +
+                            kPreset + " --set track.object=8 --set track.max_frames=1 --out " +
+                            (dir / "t").string());
+  ASSERT_EQ(track.exit_code, 0) << track.output;
+  EXPECT_THAT(track.output, HasSubstr("warning: tracker.segmentation.min_height = 0.03 m"));
+  EXPECT_THAT(track.output, HasSubstr("0.0269 m thick"));
+  const auto summary = nlohmann::json::parse(ReadBytes(dir / "t" / "track_summary.json"));
+  ASSERT_EQ(summary["warnings"].size(), 1u);
 }
 
 TEST(RealRecordingCliTest, EvalOfTheTruthItselfIsPerfect) {

@@ -82,3 +82,45 @@ TEST(TrackSessionTest, SliderOnlyModeNeedsALikeBoxAndTheSlider) {
 
 }  // namespace
 }  // namespace mmh::track
+
+namespace mmh::track {
+namespace {
+
+// A box 27 x 87 x 71 mm turned about an oblique axis and moved: its smallest width is its 27 mm
+// side (the brute-force reference: the box's own extents), found to 0.01 mm whatever the turn; a
+// regular tetrahedron of edge a has smallest width a / sqrt(2) (between opposite edges).
+TEST(TrackSessionTest, SmallestWidthOfATurnedBoxAndATetrahedron) {
+  const Eigen::Vector3f half(0.0135f, 0.0435f, 0.0355f);
+  for (double angle : {0.0, 0.3, 1.1, 2.5}) {
+    const Eigen::Matrix3f turn =
+        Eigen::AngleAxisf(static_cast<float>(angle), Eigen::Vector3f(1, 2, 3).normalized())
+            .toRotationMatrix();
+    TriangleMesh box;
+    box.vertices.resize(8, 3);
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3f corner((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(),
+                                   (i & 4 ? 1 : -1) * half.z());
+      box.vertices.row(i) = (turn * corner + Eigen::Vector3f(0.2f, -0.1f, 0.5f)).transpose();
+    }
+    EXPECT_NEAR(SmallestWidth(box), 0.027, 1e-5) << angle;
+  }
+  TriangleMesh tetrahedron;
+  tetrahedron.vertices.resize(4, 3);
+  tetrahedron.vertices << 1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1;
+  tetrahedron.vertices *= 0.01f;  // edge 2 sqrt(2) cm
+  EXPECT_NEAR(SmallestWidth(tetrahedron), 0.02, 1e-5);
+}
+
+TEST(TrackSessionTest, MinHeightWarningWhenTheModelLyingFlatIsCutOff) {
+  // The YCB-Video gelatin box (27 mm thin) under the real preset's 3 cm cut: warned, naming the
+  // option, the value and the thickness; the foam brick (50 mm) and the default 8 mm cut: not.
+  const std::string warning = MinHeightWarning(0.0269, 0.03);
+  EXPECT_THAT(warning, HasSubstr("tracker.segmentation.min_height = 0.03 m"));
+  EXPECT_THAT(warning, HasSubstr("0.0269 m thick"));
+  EXPECT_EQ(MinHeightWarning(0.0502, 0.03), "");
+  EXPECT_EQ(MinHeightWarning(0.0269, 0.008), "");
+  EXPECT_NE(MinHeightWarning(0.0399, 0.03), "");  // 9.9 mm above the cut: less than 1 cm
+}
+
+}  // namespace
+}  // namespace mmh::track
