@@ -159,12 +159,10 @@ void CalibrationOptions::Validate(const std::string& prefix) const {
   }
 }
 
-CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Targets& targets,
-                            const CalibrationOptions& options,
-                            const CalibrationProgress& progress) {
-  options.Validate("calibration");
-  const sweep::Plan plan = sweep::ReadPlan(sweep_dir);
-  const std::string where = (sweep_dir / "plan.json").string();
+namespace {
+
+// A calibration sweep: fast-fidelity studies over sampled axes (the prior), no grid.
+void CheckCalibrationSweep(const sweep::Plan& plan, const std::string& where) {
   if (plan.spec.command != sweep::SweepCommand::kStudy) {
     ThrowBadValue(where + ": command", std::string("\"") + sweep::CommandName(plan.spec.command) + "\"",
                   "\"study\": a calibration sweep runs fast-fidelity studies");
@@ -178,25 +176,21 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
     ThrowBadValue(where + ": grid", std::to_string(plan.spec.grid.size()) + " grid axes",
                   "none: every parameter a sampled axis (a grid is not a prior)");
   }
-  CalibrationResult result;
-  result.sweep_dir = sweep_dir;
-  for (const sweep::SampledAxis& axis : plan.spec.samples.axes) {
-    result.parameters.push_back({axis.key, axis.from, axis.to});
-  }
-  for (const auto& s : study::ReplicateStatistics(study::StudyAnalysis{})) {
-    result.statistics.push_back(s.name);
-  }
-  // Every replicate of every complete cell is a simulation at that cell's parameters.
+}
+
+// Every replicate of every complete cell is a simulation at that cell's parameters.
+void ReadSimulations(const sweep::Plan& plan, const std::filesystem::path& sweep_dir,
+                     const std::string& where, CalibrationResult* result) {
   for (const sweep::Cell& cell : plan.cells) {
     const sweep::CellStatus status = sweep::ReadCellStatus(sweep_dir, cell.id);
     const std::filesystem::path file = sweep::CellDir(sweep_dir, cell.id) / "out" / "replicates.csv";
     if (status.state != sweep::CellState::kComplete || !std::filesystem::exists(file)) {
-      ++result.incomplete_cells;
+      ++result->incomplete_cells;
       continue;
     }
-    ++result.cells;
+    ++result->cells;
     std::vector<double> params;
-    for (const Parameter& p : result.parameters) {
+    for (const Parameter& p : result->parameters) {
       const auto it = std::find_if(cell.params.begin(), cell.params.end(),
                                    [&](const auto& kv) { return kv.first == p.key; });
       if (it == cell.params.end() || !it->second.is_number()) {
@@ -205,39 +199,125 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
       }
       params.push_back(it->second.get<double>());
     }
-    for (auto& row : ReadReplicates(file, result.statistics)) {
-      result.simulations.push_back({params, std::move(row)});
-      result.simulation_cell.push_back(result.cells - 1);
+    for (auto& row : ReadReplicates(file, result->statistics)) {
+      result->simulations.push_back({params, std::move(row)});
+      result->simulation_cell.push_back(result->cells - 1);
     }
   }
-  if (result.cells == 0) {
+  if (result->cells == 0) {
     ThrowBadValue(sweep_dir.string(), "a sweep without complete cells",
                   "a finished sweep (mmh sweep status " + sweep_dir.string() + ")");
   }
+}
+
+// The values of statistic `k` over the given rows (missing values left out).
+std::vector<double> ColumnValues(const std::vector<std::vector<std::optional<double>>>& rows,
+                                 int k) {
+  std::vector<double> values;
+  for (const auto& row : rows) {
+    if (row[k]) values.push_back(*row[k]);
+  }
+  return values;
+}
+
+// Rejection ABC on the fitted targets, the prior sensitivity, the estimate (posterior medians)
+// and its Monte Carlo spread, and every target against the accepted simulations.
+void FitPosterior(const Targets& targets, const CalibrationOptions& options,
+                  const std::vector<double>& from, const std::vector<double>& to,
+                  CalibrationResult* result) {
   std::vector<std::pair<int, double>> fit;
   for (const Target& t : targets.targets) {
-    if (t.role == TargetRole::kFit) fit.push_back({IndexOf(result.statistics, t.statistic), t.value});
+    if (t.role == TargetRole::kFit) fit.push_back({IndexOf(result->statistics, t.statistic), t.value});
   }
-  std::vector<double> from, to;
-  for (const Parameter& p : result.parameters) from.push_back(p.from), to.push_back(p.to);
-  result.abc = RejectionAbc(result.simulations, fit, options.abc, from, to);
-  result.sensitivity =
-      PriorSensitivity(result.simulations, static_cast<int>(result.statistics.size()));
-  for (const ParameterPosterior& p : result.abc.posterior) result.estimate.push_back(p.median);
-  result.bootstrap_medians = BootstrapMedians(result.simulations, result.simulation_cell, fit,
-                                              options.abc, from, to, options.bootstrap,
-                                              options.bootstrap_seed);
-  for (std::size_t j = 0; j < result.parameters.size() && !result.bootstrap_medians.empty(); ++j) {
-    result.estimate_spread.push_back(SummarizeColumn(result.bootstrap_medians, j));
+  result->abc = RejectionAbc(result->simulations, fit, options.abc, from, to);
+  result->sensitivity =
+      PriorSensitivity(result->simulations, static_cast<int>(result->statistics.size()));
+  for (const ParameterPosterior& p : result->abc.posterior) result->estimate.push_back(p.median);
+  result->bootstrap_medians = BootstrapMedians(result->simulations, result->simulation_cell, fit,
+                                               options.abc, from, to, options.bootstrap,
+                                               options.bootstrap_seed);
+  for (std::size_t j = 0; j < result->parameters.size() && !result->bootstrap_medians.empty(); ++j) {
+    result->estimate_spread.push_back(SummarizeColumn(result->bootstrap_medians, j));
   }
   for (const Target& t : targets.targets) {
-    const int k = IndexOf(result.statistics, t.statistic);
+    const int k = IndexOf(result->statistics, t.statistic);
     std::vector<double> values;
-    for (int i : result.abc.accepted) {
-      if (result.simulations[i].values[k]) values.push_back(*result.simulations[i].values[k]);
+    for (int i : result->abc.accepted) {
+      if (result->simulations[i].values[k]) values.push_back(*result->simulations[i].values[k]);
     }
-    result.accepted_checks.push_back(Check(t, values));
+    result->accepted_checks.push_back(Check(t, values));
   }
+}
+
+// Posterior predictive check: new people and scorers (options.ppc_seed), at the rounded estimate
+// or at the accepted draws in order (nearest first, cycling when there are fewer than studies).
+void RunPredictiveCheck(const Config& config, const std::vector<double>& rounded_estimate,
+                        const CalibrationOptions& options, const CalibrationProgress& progress,
+                        CalibrationResult* result) {
+  const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
+  result->ppc_config = study_config.ToJson();
+  result->ppc_draws = options.ppc_draws == PpcDraws::kPosterior ? "posterior" : "estimate";
+  for (int r = 0; r < options.ppc_replicates; ++r) {
+    std::vector<double> theta = rounded_estimate;
+    study::StudyConfig draw_config = study_config;
+    if (options.ppc_draws == PpcDraws::kPosterior) {
+      theta = result->abc.accepted_params[r % result->abc.accepted_params.size()];
+      Config draw = config;
+      for (std::size_t j = 0; j < result->parameters.size(); ++j) {
+        draw.Set(result->parameters[j].key + "=" + Rounded(theta[j], 17));
+      }
+      draw_config = study::StudyConfig::FromConfig(draw);
+    }
+    const study::SimulatedStudy s = study::RunSimulatedStudy(draw_config.ForReplicate(r), r);
+    std::vector<std::optional<double>> row;
+    for (const auto& statistic : study::ReplicateStatistics(s.analysis)) row.push_back(statistic.value);
+    result->ppc_values.push_back(std::move(row));
+    result->ppc_params.push_back(std::move(theta));
+    if (progress) progress(r + 1, options.ppc_replicates);
+  }
+}
+
+// Every target and every conclusion against the predictive studies.
+void CheckPredictions(const Targets& targets, CalibrationResult* result) {
+  for (const Target& t : targets.targets) {
+    result->ppc.push_back(
+        Check(t, ColumnValues(result->ppc_values, IndexOf(result->statistics, t.statistic))));
+  }
+  for (const Conclusion& c : targets.conclusions) {
+    const int k = IndexOf(result->statistics, c.statistic);
+    ConclusionCheck check;
+    check.conclusion = c;
+    for (const auto& row : result->ppc_values) {
+      if (!row[k]) continue;
+      ++check.replicates;
+      check.agree += ((*row[k] < c.bound) == c.below) ? 1 : 0;
+    }
+    check.rate = check.replicates ? static_cast<double>(check.agree) / check.replicates : 0.0;
+    result->conclusions.push_back(check);
+  }
+}
+
+}  // namespace
+
+CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Targets& targets,
+                            const CalibrationOptions& options,
+                            const CalibrationProgress& progress) {
+  options.Validate("calibration");
+  const sweep::Plan plan = sweep::ReadPlan(sweep_dir);
+  const std::string where = (sweep_dir / "plan.json").string();
+  CheckCalibrationSweep(plan, where);
+  CalibrationResult result;
+  result.sweep_dir = sweep_dir;
+  for (const sweep::SampledAxis& axis : plan.spec.samples.axes) {
+    result.parameters.push_back({axis.key, axis.from, axis.to});
+  }
+  for (const auto& s : study::ReplicateStatistics(study::StudyAnalysis{})) {
+    result.statistics.push_back(s.name);
+  }
+  ReadSimulations(plan, sweep_dir, where, &result);
+  std::vector<double> from, to;
+  for (const Parameter& p : result.parameters) from.push_back(p.from), to.push_back(p.to);
+  FitPosterior(targets, options, from, to, &result);
 
   // The calibrated config: the estimate, rounded, as config sections.
   Config calibrated;
@@ -260,67 +340,21 @@ CalibrationResult Calibrate(const std::filesystem::path& sweep_dir, const Target
   result.next_round_spec =
       NextRoundSpec(plan.spec.json, sweep_dir, result.next_prior, options.next_round);
 
-  // Posterior predictive check: new people and scorers, at the estimate or at posterior draws.
   config.Set("population.seed=" + std::to_string(options.ppc_seed));
   config.Set("study.seed=" + std::to_string(options.ppc_seed));
   config.Set("run.metrics=false");
-  const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
-  result.ppc_config = study_config.ToJson();
-  result.ppc_draws = options.ppc_draws == PpcDraws::kPosterior ? "posterior" : "estimate";
-  for (int r = 0; r < options.ppc_replicates; ++r) {
-    std::vector<double> theta = rounded_estimate;
-    study::StudyConfig draw_config = study_config;
-    if (options.ppc_draws == PpcDraws::kPosterior) {
-      // The accepted draws in order (nearest first), cycling when there are fewer than studies.
-      theta = result.abc.accepted_params[r % result.abc.accepted_params.size()];
-      Config draw = config;
-      for (std::size_t j = 0; j < result.parameters.size(); ++j) {
-        draw.Set(result.parameters[j].key + "=" + Rounded(theta[j], 17));
-      }
-      draw_config = study::StudyConfig::FromConfig(draw);
-    }
-    const study::SimulatedStudy s = study::RunSimulatedStudy(draw_config.ForReplicate(r), r);
-    std::vector<std::optional<double>> row;
-    for (const auto& statistic : study::ReplicateStatistics(s.analysis)) row.push_back(statistic.value);
-    result.ppc_values.push_back(std::move(row));
-    result.ppc_params.push_back(std::move(theta));
-    if (progress) progress(r + 1, options.ppc_replicates);
-  }
-  if (options.ppc_replicates > 0) {
-    for (const Target& t : targets.targets) {
-      const int k = IndexOf(result.statistics, t.statistic);
-      std::vector<double> values;
-      for (const auto& row : result.ppc_values) {
-        if (row[k]) values.push_back(*row[k]);
-      }
-      result.ppc.push_back(Check(t, values));
-    }
-    for (const Conclusion& c : targets.conclusions) {
-      const int k = IndexOf(result.statistics, c.statistic);
-      ConclusionCheck check;
-      check.conclusion = c;
-      for (const auto& row : result.ppc_values) {
-        if (!row[k]) continue;
-        ++check.replicates;
-        check.agree += ((*row[k] < c.bound) == c.below) ? 1 : 0;
-      }
-      check.rate = check.replicates ? static_cast<double>(check.agree) / check.replicates : 0.0;
-      result.conclusions.push_back(check);
-    }
-  }
+  RunPredictiveCheck(config, rounded_estimate, options, progress, &result);
+  if (options.ppc_replicates > 0) CheckPredictions(targets, &result);
   return result;
 }
 
-void WriteCalibration(const std::filesystem::path& out, const CalibrationResult& result,
-                      const Targets& targets, const nlohmann::json& provenance) {
-  StagedFolder staged(out);
-  const std::filesystem::path& dir = staged.staging();
-  const std::size_t parameters = result.parameters.size();
+namespace {
 
-  // parameters.csv: the estimate and its uncertainty.
+// parameters.csv: the estimate and its uncertainty; returns calibration.json's "parameters".
+nlohmann::json WriteParameters(const std::filesystem::path& dir, const CalibrationResult& result) {
   std::string csv = "parameter,prior_from,prior_to,estimate,posterior_mean,posterior_sd,q05,q95\n";
   nlohmann::json params = nlohmann::json::array();
-  for (std::size_t j = 0; j < parameters; ++j) {
+  for (std::size_t j = 0; j < result.parameters.size(); ++j) {
     const Parameter& p = result.parameters[j];
     const ParameterPosterior& post = result.abc.posterior[j];
     csv += p.key + "," + Num(p.from) + "," + Num(p.to) + "," + Num(post.median) + "," +
@@ -329,25 +363,31 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
                       {"mean", post.mean}, {"sd", post.sd}, {"q05", post.q05}, {"q95", post.q95}});
   }
   WriteFileAtomically(dir / "parameters.csv", csv);
+  return params;
+}
 
-  // stability.csv: how far the estimate moves over bootstrap resamples of the cells.
-  if (!result.estimate_spread.empty()) {
-    csv = "parameter,estimate,posterior_sd,bootstrap_draws,bootstrap_sd,bootstrap_q05,"
-          "bootstrap_q95,bootstrap_sd_over_posterior_sd\n";
-    for (std::size_t j = 0; j < parameters; ++j) {
-      const ParameterPosterior& post = result.abc.posterior[j];
-      const ParameterPosterior& mc = result.estimate_spread[j];
-      csv += result.parameters[j].key + "," + Num(post.median) + "," + Num(post.sd) + "," +
-             std::to_string(result.bootstrap_medians.size()) + "," + Num(mc.sd) + "," +
-             Num(mc.q05) + "," + Num(mc.q95) + "," +
-             (post.sd > 0 ? Num(mc.sd / post.sd) : std::string()) + "\n";
-      params[j]["bootstrap"] = {{"sd", mc.sd}, {"q05", mc.q05}, {"q95", mc.q95}};
-    }
-    WriteFileAtomically(dir / "stability.csv", csv);
+// stability.csv: how far the estimate moves over bootstrap resamples of the cells (also into
+// each parameter's "bootstrap" of calibration.json).
+void WriteStability(const std::filesystem::path& dir, const CalibrationResult& result,
+                    nlohmann::json* params) {
+  if (result.estimate_spread.empty()) return;
+  std::string csv = "parameter,estimate,posterior_sd,bootstrap_draws,bootstrap_sd,bootstrap_q05,"
+                    "bootstrap_q95,bootstrap_sd_over_posterior_sd\n";
+  for (std::size_t j = 0; j < result.parameters.size(); ++j) {
+    const ParameterPosterior& post = result.abc.posterior[j];
+    const ParameterPosterior& mc = result.estimate_spread[j];
+    csv += result.parameters[j].key + "," + Num(post.median) + "," + Num(post.sd) + "," +
+           std::to_string(result.bootstrap_medians.size()) + "," + Num(mc.sd) + "," +
+           Num(mc.q05) + "," + Num(mc.q95) + "," +
+           (post.sd > 0 ? Num(mc.sd / post.sd) : std::string()) + "\n";
+    (*params)[j]["bootstrap"] = {{"sd", mc.sd}, {"q05", mc.q05}, {"q95", mc.q95}};
   }
+  WriteFileAtomically(dir / "stability.csv", csv);
+}
 
-  // posterior.csv: the accepted simulations (distance, parameters as sampled and as adjusted).
-  csv = "simulation,distance";
+// posterior.csv: the accepted simulations (distance, parameters as sampled and as adjusted).
+void WritePosterior(const std::filesystem::path& dir, const CalibrationResult& result) {
+  std::string csv = "simulation,distance";
   for (const Parameter& p : result.parameters) csv += "," + p.key;
   for (const Parameter& p : result.parameters) csv += "," + p.key + ".adjusted";
   csv += "\n";
@@ -359,9 +399,13 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
     csv += "\n";
   }
   WriteFileAtomically(dir / "posterior.csv", csv);
+}
 
-  // identification.csv: standardised sensitivity of every target statistic to every parameter.
-  csv = "statistic,role,samples,r_squared";
+// identification.csv: standardised sensitivity of every target statistic to every parameter;
+// returns calibration.json's "identification".
+nlohmann::json WriteIdentification(const std::filesystem::path& dir,
+                                   const CalibrationResult& result, const Targets& targets) {
+  std::string csv = "statistic,role,samples,r_squared";
   for (const Parameter& p : result.parameters) csv += "," + p.key;
   csv += "\n";
   nlohmann::json identification = nlohmann::json::array();
@@ -371,7 +415,7 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
            std::to_string(result.sensitivity.samples[k]) + "," +
            Num(result.sensitivity.r_squared[k]);
     nlohmann::json row = {{"statistic", t.statistic}, {"r_squared", result.sensitivity.r_squared[k]}};
-    for (std::size_t j = 0; j < parameters; ++j) {
+    for (std::size_t j = 0; j < result.parameters.size(); ++j) {
       csv += "," + Num(result.sensitivity.coefficients[k][j]);
       row["coefficients"][result.parameters[j].key] = result.sensitivity.coefficients[k][j];
     }
@@ -379,10 +423,16 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
     identification.push_back(row);
   }
   WriteFileAtomically(dir / "identification.csv", csv);
+  return identification;
+}
 
-  // targets.csv: every reported number against the accepted and the predictive distributions.
-  csv = "statistic,role,paper,accepted_median,accepted_q05,accepted_q95,ppc_samples,ppc_median,"
-        "ppc_q05,ppc_q95,ppc_quantile,inside_central_90\n";
+// targets.csv: every reported number against the accepted and the predictive distributions;
+// returns calibration.json's "targets".
+nlohmann::json WriteTargets(const std::filesystem::path& dir, const CalibrationResult& result,
+                            const Targets& targets) {
+  std::string csv =
+      "statistic,role,paper,accepted_median,accepted_q05,accepted_q95,ppc_samples,ppc_median,"
+      "ppc_q05,ppc_q95,ppc_quantile,inside_central_90\n";
   nlohmann::json checks = nlohmann::json::array();
   for (std::size_t i = 0; i < targets.targets.size(); ++i) {
     const Target& t = targets.targets[i];
@@ -404,8 +454,13 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
     checks.push_back(j);
   }
   WriteFileAtomically(dir / "targets.csv", csv);
+  return checks;
+}
 
-  csv = "conclusion,statistic,bound,below,role,replicates,agree,rate\n";
+// conclusions.csv: the paper's conclusions against the predictive studies; returns
+// calibration.json's "conclusions".
+nlohmann::json WriteConclusions(const std::filesystem::path& dir, const CalibrationResult& result) {
+  std::string csv = "conclusion,statistic,bound,below,role,replicates,agree,rate\n";
   nlohmann::json conclusions = nlohmann::json::array();
   for (const ConclusionCheck& c : result.conclusions) {
     csv += c.conclusion.id + "," + c.conclusion.statistic + "," + Num(c.conclusion.bound) + "," +
@@ -416,8 +471,12 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
                            {"agree", c.agree}, {"rate", c.rate}});
   }
   WriteFileAtomically(dir / "conclusions.csv", csv);
+  return conclusions;
+}
 
-  csv = "replicate";
+// ppc_replicates.csv: each predictive study's parameters and statistics.
+void WritePredictiveReplicates(const std::filesystem::path& dir, const CalibrationResult& result) {
+  std::string csv = "replicate";
   for (const Parameter& p : result.parameters) csv += "," + p.key;
   for (const std::string& s : result.statistics) csv += "," + s;
   csv += "\n";
@@ -428,32 +487,10 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
     csv += "\n";
   }
   WriteFileAtomically(dir / "ppc_replicates.csv", csv);
-  WriteFileAtomically(dir / "calibrated.json", result.calibrated_config.dump(2) + "\n");
-  WriteFileAtomically(dir / "config.resolved.json", result.ppc_config.dump(2) + "\n");
-  WriteFileAtomically(dir / "next_round.json", result.next_round_spec.dump(2) + "\n");
+}
 
-  nlohmann::json j;
-  j["sweep"] = result.sweep_dir.string();
-  j["targets_file"] = targets.file.string();
-  j["cells"] = result.cells;
-  j["incomplete_cells"] = result.incomplete_cells;
-  j["simulations"] = result.simulations.size();
-  j["accepted"] = result.abc.accepted.size();
-  j["epsilon"] = result.abc.epsilon;
-  j["parameters"] = params;
-  j["targets"] = checks;
-  j["conclusions"] = conclusions;
-  j["identification"] = identification;
-  j["calibrated"] = result.calibrated_config;
-  j["ppc_draws"] = result.ppc_draws;
-  nlohmann::json next_prior = nlohmann::json::array();
-  for (const Parameter& p : result.next_prior) {
-    next_prior.push_back({{"key", p.key}, {"prior", {p.from, p.to}}});
-  }
-  j["next_round_prior"] = next_prior;
-  WriteFileAtomically(dir / "calibration.json", j.dump(2) + "\n");
-
-  // report.md: the tables a reader needs first.
+// report.md: the tables a reader needs first.
+std::string ReportMarkdown(const CalibrationResult& result) {
   std::ostringstream md;
   md << "# Calibration of the simulated people\n\n"
      << result.simulations.size() << " simulated studies (" << result.cells << " cells of "
@@ -461,7 +498,7 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
      << " accepted (distance <= " << Num(result.abc.epsilon) << ").\n\n"
      << "| parameter | prior | estimate (posterior median) | central 90 % | estimate's Monte Carlo "
         "sd (bootstrap of the cells) |\n|---|---|---|---|---|\n";
-  for (std::size_t j2 = 0; j2 < parameters; ++j2) {
+  for (std::size_t j2 = 0; j2 < result.parameters.size(); ++j2) {
     const auto& p = result.parameters[j2];
     const auto& post = result.abc.posterior[j2];
     md << "| " << p.key << " | " << Num(p.from) << "–" << Num(p.to) << " | "
@@ -494,7 +531,47 @@ void WriteCalibration(const std::filesystem::path& out, const CalibrationResult&
          << " / " << c.replicates << " = " << Rounded(c.rate, 3) << " |\n";
     }
   }
-  WriteFileAtomically(dir / "report.md", md.str());
+  return md.str();
+}
+
+}  // namespace
+
+void WriteCalibration(const std::filesystem::path& out, const CalibrationResult& result,
+                      const Targets& targets, const nlohmann::json& provenance) {
+  StagedFolder staged(out);
+  const std::filesystem::path& dir = staged.staging();
+  nlohmann::json params = WriteParameters(dir, result);
+  WriteStability(dir, result, &params);
+  WritePosterior(dir, result);
+  const nlohmann::json identification = WriteIdentification(dir, result, targets);
+  const nlohmann::json checks = WriteTargets(dir, result, targets);
+  const nlohmann::json conclusions = WriteConclusions(dir, result);
+  WritePredictiveReplicates(dir, result);
+  WriteFileAtomically(dir / "calibrated.json", result.calibrated_config.dump(2) + "\n");
+  WriteFileAtomically(dir / "config.resolved.json", result.ppc_config.dump(2) + "\n");
+  WriteFileAtomically(dir / "next_round.json", result.next_round_spec.dump(2) + "\n");
+
+  nlohmann::json j;
+  j["sweep"] = result.sweep_dir.string();
+  j["targets_file"] = targets.file.string();
+  j["cells"] = result.cells;
+  j["incomplete_cells"] = result.incomplete_cells;
+  j["simulations"] = result.simulations.size();
+  j["accepted"] = result.abc.accepted.size();
+  j["epsilon"] = result.abc.epsilon;
+  j["parameters"] = params;
+  j["targets"] = checks;
+  j["conclusions"] = conclusions;
+  j["identification"] = identification;
+  j["calibrated"] = result.calibrated_config;
+  j["ppc_draws"] = result.ppc_draws;
+  nlohmann::json next_prior = nlohmann::json::array();
+  for (const Parameter& p : result.next_prior) {
+    next_prior.push_back({{"key", p.key}, {"prior", {p.from, p.to}}});
+  }
+  j["next_round_prior"] = next_prior;
+  WriteFileAtomically(dir / "calibration.json", j.dump(2) + "\n");
+  WriteFileAtomically(dir / "report.md", ReportMarkdown(result));
   WriteFileAtomically(dir / "run.json", provenance.dump(2) + "\n");
   staged.Commit();
 }
