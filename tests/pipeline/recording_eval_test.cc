@@ -45,14 +45,26 @@ std::string TruthAsEstimate(const TempDir& dir, std::vector<int> drop = {}) {
   return path;
 }
 
-TEST(RecordingEvalTest, TheTruthAsEstimateScoresPerfectly) {
-  TempDir dir;
+// The brick of video 0000 with its truth as the estimate, as `mmh eval --input VIDEO --model BRICK
+// --estimate FILE --set track.object=21` gives them.
+RecordingEvalInputs BrickInputs(const TempDir& dir) {
   RecordingEvalInputs inputs;
   inputs.recording = kVideo.string();
   inputs.estimates = {TruthAsEstimate(dir)};
   inputs.models = {kBrick};
+  return inputs;
+}
+
+RecordingEvalOptions Brick() {
   RecordingEvalOptions options;
   options.object = 21;
+  return options;
+}
+
+TEST(RecordingEvalTest, TheTruthAsEstimateScoresPerfectly) {
+  TempDir dir;
+  const RecordingEvalInputs inputs = BrickInputs(dir);
+  const RecordingEvalOptions options = Brick();
   const RecordingEvaluation result = EvaluateRecording(inputs, options, WithoutVsd());
   ASSERT_EQ(result.objects.size(), 1u);
   const metrics::BopRecall& r = result.objects[0].recall;
@@ -81,11 +93,8 @@ TEST(RecordingEvalTest, AFrameWithoutEstimateIsAMiss) {
 
 TEST(RecordingEvalTest, MistakesNameTheFlagOrKey) {
   TempDir dir;
-  RecordingEvalInputs inputs;
-  inputs.recording = kVideo.string();
-  inputs.estimates = {TruthAsEstimate(dir)};
-  inputs.models = {kBrick};
-  RecordingEvalOptions options;
+  RecordingEvalInputs inputs = BrickInputs(dir);
+  RecordingEvalOptions options = Brick();
   options.object = 99;
   EXPECT_NE(ErrorOf([&] { EvaluateRecording(inputs, options, WithoutVsd()); }).find("track.object"),
             std::string::npos);
@@ -110,13 +119,8 @@ TEST(RecordingEvalTest, MistakesNameTheFlagOrKey) {
 
 TEST(RecordingEvalTest, TheFolderIsWrittenWhole) {
   TempDir dir;
-  RecordingEvalInputs inputs;
-  inputs.recording = kVideo.string();
-  inputs.estimates = {TruthAsEstimate(dir)};
-  inputs.models = {kBrick};
-  RecordingEvalOptions options;
-  options.object = 21;
-  const RecordingEvaluation result = EvaluateRecording(inputs, options, WithoutVsd());
+  const RecordingEvalInputs inputs = BrickInputs(dir);
+  const RecordingEvaluation result = EvaluateRecording(inputs, Brick(), WithoutVsd());
   const fs::path out = dir / "eval";
   WriteRecordingEvaluation(out, result, inputs, {{"track", 1}}, {{"writer", "mmh"}});
   EXPECT_EQ(ListDir(out),
