@@ -46,11 +46,18 @@ nlohmann::json BrowserCheck(const std::filesystem::path& html, const std::vector
                         html.string() + "'";
   if (!list.empty()) command += " --frames " + list;
   if (!screenshot.empty()) command += " --screenshot '" + screenshot.string() + "'";
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
   std::string output;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
-  const int status = pclose(pipe);
+  int status = 0;
+  // Once in a clean-clone CI run (2026-11-28, beside the whole suite at -j2) the check came back
+  // with status 0 and no output at all, and passed when run again: a harness hiccup, not a page
+  // failure (a page failure prints its JSON). Only that case is tried a second time.
+  for (int attempt = 0; attempt < 2 && output.empty(); ++attempt) {
+    FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+    char buffer[4096];
+    while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+    status = pclose(pipe);
+    if (output.empty()) std::fprintf(stderr, "browser check: no output (status %d)\n", status);
+  }
   EXPECT_EQ(status, 0) << output;
   const auto brace = output.rfind("\n{");
   const std::string json = output.substr(brace == std::string::npos ? 0 : brace + 1);
