@@ -52,6 +52,15 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+#ifdef MMH_TEST_DATA_DIR
+// The committed real YCB-Video excerpt (tests/data/real/ycbv, PROVENANCE.md there) and its video
+// 0000, which several suites track and score.
+inline std::filesystem::path RealYcbvDir() {
+  return std::filesystem::path(MMH_TEST_DATA_DIR) / "real" / "ycbv";
+}
+inline std::filesystem::path RealYcbvVideo() { return RealYcbvDir() / "data" / "0000"; }
+#endif
+
 // Writes `text` to `path` as it is (binary).
 inline void WriteText(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

@@ -20,8 +20,8 @@ using test_util::ErrorOf;
 using test_util::ListDir;
 using test_util::TempDir;
 
-const fs::path kReal = fs::path(MMH_TEST_DATA_DIR) / "real" / "ycbv";
-const fs::path kVideo = kReal / "data" / "0000";
+const fs::path kReal = test_util::RealYcbvDir();
+const fs::path kVideo = test_util::RealYcbvVideo();
 const std::string kBrick = (kReal / "models" / "061_foam_brick.obj").string();
 
 metrics::PoseEvaluationOptions WithoutVsd() {

@@ -23,8 +23,8 @@ using test_util::ErrorOf;
 using test_util::ListDir;
 using test_util::TempDir;
 
-const fs::path kReal = fs::path(MMH_TEST_DATA_DIR) / "real" / "ycbv";
-const fs::path kVideo = kReal / "data" / "0000";
+const fs::path kReal = test_util::RealYcbvDir();
+const fs::path kVideo = test_util::RealYcbvVideo();
 
 track::TrackConfig RealConfig(const std::vector<std::string>& sets) {
   Config config = Config::Load(fs::path(MMH_SOURCE_DIR) / "configs" / "track_real.json");

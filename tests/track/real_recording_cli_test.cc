@@ -24,8 +24,8 @@ using test_util::TempDir;
 using test_util::WriteText;
 using ::testing::HasSubstr;
 
-const fs::path kReal = fs::path(MMH_TEST_DATA_DIR) / "real" / "ycbv";
-const fs::path kVideo = kReal / "data" / "0000";
+const fs::path kReal = test_util::RealYcbvDir();
+const fs::path kVideo = test_util::RealYcbvVideo();
 const std::string kPreset = std::string(MMH_SOURCE_DIR) + "/configs/track_real.json";
 
 struct Scores {
