@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/atomic_file.h"
+#include "core/stale_temporaries.h"
 #include "core/error.h"
 #include "core/json_text.h"
 #include "pipeline/run_metrics.h"
@@ -53,6 +54,8 @@ AnimatorRun RunToFolder(const RunConfig& config, const std::filesystem::path& ou
   const nlohmann::json resolved = config.ToJson();
   if (options.resume) CheckResumable(out, resolved);
   EnsureDirectory(out);
+  // A run killed between a write and its rename left a temporary: this run continues in place.
+  RemoveStaleTemporaries(out);
   auto write_provenance = [&](const nlohmann::json& timings) {
     if (options.provenance) {
       WriteFileAtomically(out / "run.json", options.provenance(timings).dump(2) + "\n");

@@ -78,16 +78,21 @@ TEST(RunCliTest, FailedTrackingKeepsTheFinishedStages) {
   EXPECT_FALSE(std::filesystem::exists(dir / "out/metrics.json"));
 }
 
-// --resume reuses the finished takes (a montage option may change), and refuses a folder whose
-// config or files do not belong to the run.
+// --resume reuses the finished takes (a montage option may change), removes what a killed writer
+// left, and refuses a folder whose config or files do not belong to the run.
 TEST(RunCliTest, ResumeReusesFinishedTakesAndRefusesInconsistentOnes) {
   TempDir dir;
   const auto out = dir / "out";
   ASSERT_EQ(RunMmh(ShortRun(out)).exit_code, 0);
   const std::string tracked = ReadBytes(out / "takes/take_1/tracked.tum");
+  // What a run killed between a write and its rename leaves (PID 2^22 + 1: above PID_MAX_LIMIT,
+  // Linux's largest PID, so no process runs under it): the resumed run removes it.
+  const auto stale = out / "takes/take_1/status.csv.tmp.4194305.7";
+  WriteText(stale, "frame,timestamp,sta");
   auto r = RunMmh(ShortRun(out, "--resume --set montage.blend.window=5"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(ReadBytes(out / "takes/take_1/tracked.tum"), tracked);
+  EXPECT_FALSE(std::filesystem::exists(stale));
   const nlohmann::json run = nlohmann::json::parse(ReadBytes(out / "run.json"));
   EXPECT_EQ(run["seconds"]["rendered_frames"], 0);  // nothing rendered again
   r = RunMmh(ShortRun(out, "--resume --set tracker.verification.max_rms=0.003"));
