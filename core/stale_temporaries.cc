@@ -28,15 +28,25 @@ bool ProcessRunning(long pid) {
 
 }  // namespace
 
-int RemoveStaleTemporaries(const std::filesystem::path& dir) {
+int RemoveStaleTemporaries(const std::filesystem::path& dir, bool subfolders) {
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) return 0;
   std::vector<std::filesystem::path> stale;
-  for (std::filesystem::recursive_directory_iterator it(dir, ec), end; !ec && it != end;
-       it.increment(ec)) {
-    if (!it->is_regular_file(ec)) continue;
-    const long owner = TemporaryOwner(it->path().filename().string());
-    if (owner > 0 && !ProcessRunning(owner)) stale.push_back(it->path());
+  auto consider = [&](const std::filesystem::directory_entry& entry) {
+    if (!entry.is_regular_file(ec)) return;
+    const long owner = TemporaryOwner(entry.path().filename().string());
+    if (owner > 0 && !ProcessRunning(owner)) stale.push_back(entry.path());
+  };
+  if (subfolders) {
+    for (std::filesystem::recursive_directory_iterator it(dir, ec), end; !ec && it != end;
+         it.increment(ec)) {
+      consider(*it);
+    }
+  } else {
+    for (std::filesystem::directory_iterator it(dir, ec), end; !ec && it != end;
+         it.increment(ec)) {
+      consider(*it);
+    }
   }
   int removed = 0;
   for (const auto& file : stale) removed += std::filesystem::remove(file, ec) ? 1 : 0;

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "core/json_text.h"
 #include "core/options.h"
+#include "core/stale_temporaries.h"
 #include "core/text_parsing.h"
 #include "sweep/command_config.h"
 
@@ -470,6 +471,12 @@ void WritePlan(const fs::path& dir, const Plan& plan) {
                   "a new or empty folder, or the folder of an earlier sweep of this spec");
   }
   const bool continued = fs::exists(plan_file);
+  // What a killed `mmh sweep` left between a write and its rename. The plan and the configs are
+  // written only by this command, the tables by its aggregation (here, or the Slurm job that a
+  // rerun does not run beside); cells/, which workers on other hosts write, is not swept.
+  for (const fs::path& folder : {dir, dir / "configs", dir / "plots"}) {
+    RemoveStaleTemporaries(folder, /*subfolders=*/false);
+  }
   EnsureDirectory(dir / "configs");
   for (const auto& cell : plan.cells) {
     // Without a plan.json, configs of a killed writer are not trusted: all are written again.

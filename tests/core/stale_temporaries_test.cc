@@ -43,7 +43,9 @@ TEST(StaleTemporaries, OnlyTheTemporariesOfExitedWritersAreRemoved) {
         dir / ("x.tmp." + dead + ".1.two.dots")}) {
     WriteFileAtomically(file, std::string("x"));
   }
-  EXPECT_EQ(RemoveStaleTemporaries(dir.path()), 3);
+  EXPECT_EQ(RemoveStaleTemporaries(dir.path(), /*subfolders=*/false), 1);  // metrics.json's
+  EXPECT_EQ(ListDir(dir / "takes" / "take_0").size(), 2u);
+  EXPECT_EQ(RemoveStaleTemporaries(dir.path()), 2);
   EXPECT_EQ(ListDir(dir.path()),
             (std::vector<std::string>{"config.json.tmp." + alive + ".1", "metrics.json",
                                       "notes.tmp.txt", "takes", "x.tmp." + dead,

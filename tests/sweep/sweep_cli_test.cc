@@ -191,10 +191,13 @@ TEST_F(SweepCliTest, BadInputIsExitTwoNamingSpecAxisAndValueAndWritesNothing) {
   test_util::WriteText(temp_ / "killed" / "configs" / "0123456789abcdef.json", "{\"cut");
   test_util::WriteText(temp_ / "killed" / "configs" / "x.json.tmp.99.0", "{");
   test_util::WriteText(temp_ / "killed" / "plan.json.tmp.99.1", "{");
+  // A killed writer's (PID 2^22 + 1: above Linux's largest PID, so no process runs under it).
+  test_util::WriteText(temp_ / "killed" / "configs" / "y.json.tmp.4194305.0", "{");
   r = RunMmh("sweep --dry-run --quiet --spec " + good.string() + " --out " +
              (temp_ / "killed").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(temp_ / "killed" / "plan.json"));
+  EXPECT_FALSE(fs::exists(temp_ / "killed" / "configs" / "y.json.tmp.4194305.0"));
   for (const auto& e : fs::directory_iterator(temp_ / "killed" / "configs")) {
     const std::string name = e.path().filename().string();
     if (name.find(".tmp.") != std::string::npos || name == "0123456789abcdef.json") continue;
