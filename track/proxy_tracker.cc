@@ -54,6 +54,13 @@ void DetectionOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".model_segments", std::to_string(model_segments), ">= 0 (0: off)");
   }
   RequireNonNegative(segment_slack, prefix + ".segment_slack", "m");
+  if (!(own_segment_share >= 0 && own_segment_share <= 1)) {
+    ThrowBadValue(prefix + ".own_segment_share", FormatNumber(own_segment_share),
+                  "in [0, 1] (0: off)");
+  }
+  if (!(own_segment_distance > 0)) {
+    ThrowBadValue(prefix + ".own_segment_distance", FormatNumber(own_segment_distance), "> 0 m");
+  }
   if (trusted_frames < 0) {
     ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
   }
@@ -571,6 +578,22 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAmongSegments(
     PrepareData();
     std::optional<Candidate> candidate = Detect(frame, predicted, false);
     if (!candidate) continue;
+    if (o.own_segment_share > 0) {
+      // Scored as tracking will score it (own_segment_share): on all of the frame's segments that
+      // lie on the model at this pose, refined there. An object seen as several segments (the
+      // mug's outer wall and its inside, split at the rim by segmentation.max_depth_jump) is
+      // then ranked on all of them, not on the part one segment shows.
+      segmentation_ = whole;
+      KeepOwnSegments(candidate->icp.proxy_T_camera.Inverse());
+      PrepareData();
+      if (static_cast<int>(data_.size()) >= options_.verification.min_points) {
+        candidate = Verify(frame, AlignPointToPlane(*model_, data_, scored_,
+                                                    options_.verification.skin_distance,
+                                                    candidate->icp.proxy_T_camera, search_icp_,
+                                                    sample_matches_));
+        segment = segmentation_;
+      }
+    }
     // The inlier share is of this segment's points, which a pose on a small part of another
     // object also explains: the share of the model's visible surface that the depth confirms
     // tells the object that fills the model.
@@ -766,9 +789,46 @@ std::string ProxyTracker::FrameProblem(const RgbdFrame& frame) const {
   return "";
 }
 
+void ProxyTracker::KeepOwnSegments(const Rigid3& camera_T_proxy) {
+  const DetectionOptions& o = options_.detection;
+  const Eigen::Matrix3f r = camera_T_proxy.rotation.toRotationMatrix().cast<float>().transpose();
+  const Eigen::Vector3f t = camera_T_proxy.translation.cast<float>();
+  const float max_squared = static_cast<float>(o.own_segment_distance * o.own_segment_distance);
+  const size_t count = segmentation_.component_sizes.size();
+  std::vector<int> near(count, 0), total(count, 0);
+  for (size_t i = 0; i < segmentation_.points.size(); ++i) {
+    const int c = segmentation_.components[i];
+    ++total[c];
+    // The grid's nearest sample (track/proxy_model.h; within its margin, else none): the distance
+    // to the surface up to the sample spacing, enough to tell the object from what lies beside it.
+    const Eigen::Vector3f model_p = r * (segmentation_.points[i] - t);
+    const int s = model_->Closest(model_p);
+    if (s >= 0 && (model_->points()[s] - model_p).squaredNorm() <= max_squared) ++near[c];
+  }
+  std::vector<int> renumbered(count, -1);
+  std::vector<int> sizes;
+  for (size_t c = 0; c < count; ++c) {
+    if (total[c] > 0 && near[c] >= o.own_segment_share * total[c]) {
+      renumbered[c] = static_cast<int>(sizes.size());
+      sizes.push_back(segmentation_.component_sizes[c]);
+    }
+  }
+  size_t kept = 0;
+  for (size_t i = 0; i < segmentation_.points.size(); ++i) {
+    const int c = renumbered[segmentation_.components[i]];
+    if (c < 0) continue;
+    segmentation_.points[kept] = segmentation_.points[i];
+    segmentation_.components[kept++] = c;
+  }
+  segmentation_.points.resize(kept);
+  segmentation_.components.resize(kept);
+  segmentation_.component_sizes = std::move(sizes);
+}
+
 void ProxyTracker::SegmentFrame(const RgbdFrame& frame, const ImageRect* window,
-                                TrackFrameResult* result) {
+                                TrackFrameResult* result, const Rigid3* own) {
   segmenter_.Segment(frame, &segmentation_, window);
+  if (own && options_.detection.own_segment_share > 0) KeepOwnSegments(*own);
   result->points = static_cast<int>(segmentation_.points.size());
   result->skin_points = static_cast<int>(segmentation_.skin_points.size());
   PrepareData();
@@ -907,7 +967,7 @@ TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
   const std::optional<Rigid3> predicted = motion_->Predict();
   ImageRect window;
   if (predicted) window = ProxyImage(*predicted, options_.segmentation.window_margin);
-  SegmentFrame(frame, predicted ? &window : nullptr, &result);
+  SegmentFrame(frame, predicted ? &window : nullptr, &result, predicted ? &*predicted : nullptr);
   bool windowed = predicted.has_value();
   std::optional<Candidate> chosen;
   if (predicted && result.points >= options_.verification.min_points) {

@@ -17,6 +17,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -232,6 +233,29 @@ TEST(ProxyTrackerTest, SlideDropMustNotBeNegative) {
     EXPECT_NE(std::string(e.what()).find("tracker.detection.slide_drop"), std::string::npos)
         << e.what();
   }
+}
+
+// The real recordings' own-segment rule (DetectionOptions::own_segment_share, 0 = off) takes a
+// share and a positive distance; an error names the option and the value.
+TEST(ProxyTrackerTest, OwnSegmentShareMustBeAShare) {
+  for (const auto& [share, distance, name] :
+       {std::tuple{1.5, 0.01, "own_segment_share"}, std::tuple{-0.1, 0.01, "own_segment_share"},
+        std::tuple{0.6, 0.0, "own_segment_distance"}}) {
+    ProxyTrackerOptions options;
+    options.detection.own_segment_share = share;
+    options.detection.own_segment_distance = distance;
+    try {
+      options.Validate("tracker");
+      FAIL() << "no error for " << name;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("tracker.detection.") + name),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  ProxyTrackerOptions options;
+  options.detection.own_segment_share = 0.6;
+  EXPECT_NO_THROW(options.Validate("tracker"));
 }
 
 // The Mario story (configs/mario.json), participant 0's take 0, frames 150-449: Mario's half turn

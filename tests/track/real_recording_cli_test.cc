@@ -1,5 +1,5 @@
 // `mmh track` and `mmh eval` on the committed real YCB-Video frames (tests/data/real/ycbv): the
-// gelatin box and the foam brick tracked from the ground truth's first pose, scored by `mmh eval` against the dataset's poses; and the bad inputs
+// gelatin box, the foam brick and the mug tracked from the ground truth's first pose, scored by `mmh eval` against the dataset's poses; and the bad inputs
 // the issue names (a model 1000 times too big, a recording without a depth scale, inconsistent
 // ground truth): exit code 2 with the file and the value.
 #include <gmock/gmock.h>
@@ -162,6 +162,35 @@ TEST(RealRecordingCliTest, FindsACanOnARealFrameFromItsOwnDetection) {
                              (dir / "strict").string());
   EXPECT_NE(strict.exit_code, 0);
   EXPECT_THAT(ReadBytes(dir / "strict" / "status.csv"), HasSubstr("into the table"));
+}
+
+// The mug (YCB 025: a cylinder with a hollow and a handle, not convex) in the same ten frames,
+// with the YCB set's own scan of it (models_real/025_mug.obj, PROVENANCE.md). The foam brick stands
+// in front of it, so the predicted mug's window holds the brick too: scored on the whole window the
+// true pose explains 27 % of the points (< 0.5) and the track is lost on the first frame; each
+// detection then takes a pose turned about the mug's axis (120 deg: the handle is hidden behind
+// the mug). tracker.detection.own_segment_share = 0.6 scores a pose on the segments that lie on the
+// model. Measured (docs/tracker.md, "The sim-to-real gap"): from the truth's first pose 2.04 deg /
+// 0.73 mm, all 10 frames within 5 deg / 5 cm, AR 0.990; from its own detection 5.00 deg / 0.87 mm,
+// 5 of 10 within 5 deg / 5 cm, AR 0.942 (the error is a turn about the mug's axis, which the
+// hidden handle leaves open: the axis itself is 0.3-2.9 deg off). Without the option: 119.7 deg.
+TEST(RealRecordingCliTest, TracksTheMugWithItsScannedMesh) {
+  TempDir dir;
+  const std::string own = "--set tracker.detection.own_segment_share=0.6";
+  const Scores truth = TrackAndEval(dir, 14, "models_real/025_mug.obj", "truth", kVideo, own);
+  EXPECT_LT(truth.median_rotation_deg, 3.0);
+  EXPECT_LT(truth.median_translation_mm, 2.0);
+  EXPECT_GE(truth.recall_5deg_5cm, 0.9);
+  EXPECT_GE(truth.ar, 0.95);
+  const Scores detection =
+      TrackAndEval(dir, 14, "models_real/025_mug.obj", "detection", kVideo, own);
+  EXPECT_LT(detection.median_rotation_deg, 7.0);
+  EXPECT_LT(detection.median_translation_mm, 2.5);
+  EXPECT_GE(detection.ar, 0.9);
+  // The option's reason: without it the truth's pose is not kept.
+  TempDir off;
+  const Scores without = TrackAndEval(off, 14, "models_real/025_mug.obj", "truth");
+  EXPECT_LE(without.recall_5deg_5cm, 0.5);
 }
 
 // The real preset's 3 cm cut would hide the gelatin box (27 mm thin) lying flat: `mmh track` warns
