@@ -7,11 +7,12 @@
 //
 // MAD_k the median absolute deviation of s_k over all simulations (× 1.4826, so that it estimates
 // a standard deviation), and the simulations with the smallest `accept_fraction` of distances are
-// a sample of the approximate posterior p(θ | d ≤ ε). With `regression_adjustment` each accepted
-// θ_i is corrected for how far its summaries fell from the observed ones (Beaumont, Zhang &
-// Balding 2002, eq. 4): θ_i* = θ_i − β̂ᵀ (s_i − t), β̂ from the weighted least-squares regression
-// of θ on s among the accepted, Epanechnikov weights 1 − (d_i/ε)²; θ_i* is kept in the prior's
-// range. The adjustment removes the part of the posterior's spread that ε lets through.
+// a sample of the approximate posterior p(θ | d ≤ ε). With `regression_adjustment` (off by
+// default: AbcOptions says why) each accepted θ_i is corrected for how far its summaries fell
+// from the observed ones (Beaumont, Zhang & Balding 2002, eq. 4): θ_i* = θ_i − β̂ᵀ (s_i − t), β̂
+// from the weighted least-squares regression of θ on s among the accepted, Epanechnikov weights
+// 1 − (d_i/ε)²; θ_i* is kept in the prior's range. The adjustment removes the part of the
+// posterior's spread that ε lets through.
 #pragma once
 
 #include <cstdint>
@@ -29,7 +30,15 @@ struct Simulation {
 // Options of RejectionAbc.
 struct AbcOptions {
   double accept_fraction = 0.05;  // share of the simulations accepted, in (0, 1]
-  bool regression_adjustment = true;
+  // Off by default: the adjustment fits 1 + #fit statistics coefficients per parameter (11 for
+  // paper_targets_with_h3.json) to the accepted studies, about 120 of a 2 400-study sweep, and its
+  // noise moved the posterior median by as much as the posterior's own sd between bootstrap
+  // resamples of the cells (stability.csv: 0.85-1.32 x in two rounds), against 0.24-0.42 x
+  // without it (docs/calibration.md, "A second round"). Beaumont, Zhang & Balding (2002) fitted
+  // it to thousands of accepted simulations; at these sweep sizes plain rejection (Pritchard et
+  // al. 1999) gives a stable estimate at the price of a posterior widened by ε. Turn it on for
+  // sweeps with many more accepted studies than fit statistics.
+  bool regression_adjustment = false;
 
   template <class V>
   void VisitFields(V& v) {

@@ -385,7 +385,8 @@ void WriteStability(const std::filesystem::path& dir, const CalibrationResult& r
   WriteFileAtomically(dir / "stability.csv", csv);
 }
 
-// posterior.csv: the accepted simulations (distance, parameters as sampled and as adjusted).
+// posterior.csv: the accepted simulations (distance, parameters as sampled and as adjusted; the
+// same when calibration.abc.regression_adjustment is off).
 void WritePosterior(const std::filesystem::path& dir, const CalibrationResult& result) {
   std::string csv = "simulation,distance";
   for (const Parameter& p : result.parameters) csv += "," + p.key;
@@ -512,8 +513,9 @@ std::string ReportMarkdown(const CalibrationResult& result) {
     md << " " << p.key << " " << Rounded(p.from, 3) << "–" << Rounded(p.to, 3) << ";";
   }
   md << "\n\nPosterior predictive check: " << result.ppc_values.size() << " new studies "
-     << (result.ppc_draws == "posterior" ? "at draws from the posterior (the accepted θ, as adjusted)"
-                                         : "at the rounded estimate")
+     << (result.ppc_draws == "posterior"
+             ? "at draws from the posterior (the accepted θ: posterior.csv's .adjusted columns)"
+             : "at the rounded estimate")
      << ".\n";
   md << "\n| statistic | role | paper | predictive median (90 %) | quantile of the paper's |\n"
         "|---|---|---|---|---|\n";
