@@ -15,8 +15,10 @@
 #include "core/config.h"
 #include "core/mesh_io.h"
 #include "metrics/tracking_metrics.h"
+#include "tests/test_meshes.h"
 #include "tests/track/sim_take.h"
 #include "track/internal/pcl_icp_baseline.h"
+#include "track/proxy_model.h"
 #include "track/proxy_tracker.h"
 #include "track/segmentation.h"
 #include "track/recording.h"
@@ -211,6 +213,18 @@ void BM_RealRecordingPerFrame(benchmark::State& state) {
 BENCHMARK(BM_RealRecording)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RealRecordingFromDetection)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RealRecordingPerFrame)->Unit(benchmark::kMillisecond);
+
+// Building the closest-point grid of a large model: a 25 cm cube at the default grid resolution
+// (ProxyModelTest.BigModelsAreBuiltAndNonsenseIsRejected checks the result, this the time).
+void BM_ProxyModelBuild(benchmark::State& state) {
+  const TriangleMesh cube =
+      test_util::BoxMesh(Eigen::Vector3d(-0.125, -0.125, 0), Eigen::Vector3d(0.125, 0.125, 0.25));
+  for (auto _ : state) {
+    const ProxyModel model(cube, ProxyModelOptions(), "cube");
+    benchmark::DoNotOptimize(model.grid_bytes());
+  }
+}
+BENCHMARK(BM_ProxyModelBuild)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace mmh::track

@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -119,10 +118,14 @@ TEST(ProxyModelTest, ANoiseFreeFrameIsFittedAtTheTruth) {
   EXPECT_LT(median(translations), 0.0007);
 }
 
-TEST(ProxyModelTest, BigModelsBuildQuicklyAndNonsenseIsRejected) {
-  const auto start = std::chrono::steady_clock::now();
+// A 25 cm model builds (its speed: BM_ProxyModelBuild in bench/bench_track.cc; a wall-clock limit
+// here failed under load) and answers closest-sample queries at its surface.
+TEST(ProxyModelTest, BigModelsAreBuiltAndNonsenseIsRejected) {
   const ProxyModel big(Box(0.25f, 0.25f, 0.25f), ProxyModelOptions(), "cube");
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 10.0);
+  const Eigen::Vector3f on_top(0.01f, -0.02f, 0.25f);
+  const int s = big.Closest(on_top);
+  ASSERT_GE(s, 0);
+  EXPECT_LT((big.points()[s] - on_top).norm(), 0.01f);
   EXPECT_THAT(ErrorOf([] { ProxyModel m(Box(30, 30, 30), ProxyModelOptions(), "mm.ply"); }),
               HasSubstr("scale of 0.001"));
   ProxyModelOptions bad;
