@@ -1,23 +1,18 @@
 #include "core/atomic_file.h"
 
-#include <unistd.h>
-
-#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <system_error>
 
 #include "core/error.h"
+#include "core/temporary_name.h"
 
 namespace mmh {
 
 void WriteFileAtomically(const std::filesystem::path& path,
                          const std::function<void(std::ostream&)>& write) {
-  // Unique per process and call, so that concurrent writers never share a temporary.
-  static std::atomic<unsigned> counter{0};
-  std::filesystem::path temporary = path;
-  temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  const std::filesystem::path temporary = TemporaryBeside(path);
   try {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out) {

@@ -7,7 +7,6 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
@@ -20,6 +19,7 @@
 #include "core/error.h"
 #include "core/error_text.h"
 #include "core/resource_limits.h"
+#include "core/temporary_name.h"
 
 namespace mmh::internal {
 namespace {
@@ -153,15 +153,6 @@ std::vector<T> ReadPixels(OIIO::ImageInput& input, const fs::path& path, OIIO::T
   return pixels;
 }
 
-// A temporary name beside `path` that keeps its extension (OpenImageIO picks the format by it).
-fs::path TemporaryBeside(const fs::path& path) {
-  static std::atomic<unsigned> counter{0};
-  fs::path temporary =
-      path.parent_path() / (path.stem().string() + ".tmp." + std::to_string(::getpid()) + "." +
-                            std::to_string(counter++) + path.extension().string());
-  return temporary;
-}
-
 OIIO::ImageSpec PngSpec(int width, int height, int channels, OIIO::TypeDesc format,
                         int compression) {
   if (compression < 0 || compression > 9) {
@@ -174,7 +165,8 @@ OIIO::ImageSpec PngSpec(int width, int height, int channels, OIIO::TypeDesc form
 
 // Writes one image through OpenImageIO to a temporary file, then renames it over `path`.
 void WriteImageAtomically(const fs::path& path, const OIIO::ImageSpec& spec, const void* pixels) {
-  const fs::path temporary = TemporaryBeside(path);
+  // The extension kept: OpenImageIO picks the format by it.
+  const fs::path temporary = TemporaryBeside(path, /*keep_extension=*/true);
   auto remove_temporary = [&] {
     std::error_code ignored;
     fs::remove(temporary, ignored);
