@@ -8,23 +8,13 @@
 #include <vector>
 
 #include "montage/labelling.h"
+#include "tests/montage/labelling_problem.h"
 #include "tests/montage/oracles.h"
 
 namespace mmh::montage {
 namespace {
 
 using oracle::NearRel;
-
-LabellingProblem ToProblem(const oracle::Problem& p) {
-  LabellingProblem q;
-  q.frames = p.n;
-  q.takes = p.m;
-  q.data = p.data;
-  q.transitions.frames = p.n;
-  q.transitions.takes = p.m;
-  q.transitions.values = p.trans;
-  return q;
-}
 
 std::string Describe(const oracle::Problem& p, double mu, int d) {
   std::ostringstream os;
@@ -147,7 +137,7 @@ TEST(LabellingBruteForce, MatchesExhaustiveEnumeration) {
     LabellingOptions options;
     options.mu = mu;
     options.min_segment_length = d;
-    const LabellingProblem problem = ToProblem(p);
+    const LabellingProblem problem = ToLabellingProblem(p);
     const LabellingResult r = SolveLabelling(problem, options);
 
     ASSERT_EQ(int(r.labels.size()), n);
@@ -222,7 +212,7 @@ TEST(LabellingBruteForce, LongerTwoTakeInstances) {
     LabellingOptions options;
     options.mu = mu;
     options.min_segment_length = d;
-    const LabellingResult r = SolveLabelling(ToProblem(p), options);
+    const LabellingResult r = SolveLabelling(ToLabellingProblem(p), options);
     EXPECT_TRUE(r.feasible);
     EXPECT_TRUE(oracle::Feasible(r.labels, d)) << LabelsString(r.labels);
     EXPECT_TRUE(NearRel(r.total_cost, best)) << "optimum " << best << ", got " << r.total_cost;
@@ -268,7 +258,7 @@ TEST(LabellingBruteForce, HandWorkedConstraint) {
     p.trans[(t * 2 + 0) * 2 + 1] = 0.25;
     p.trans[(t * 2 + 1) * 2 + 0] = 0.25;
   }
-  const LabellingProblem problem = ToProblem(p);
+  const LabellingProblem problem = ToLabellingProblem(p);
   LabellingOptions options;
   options.mu = 0.0;
   options.min_segment_length = 0;

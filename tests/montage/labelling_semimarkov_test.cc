@@ -8,23 +8,13 @@
 #include <vector>
 
 #include "montage/labelling.h"
+#include "tests/montage/labelling_problem.h"
 #include "tests/montage/oracles.h"
 
 namespace mmh::montage {
 namespace {
 
 using oracle::NearRel;
-
-LabellingProblem ToProblem(const oracle::Problem& p) {
-  LabellingProblem q;
-  q.frames = p.n;
-  q.takes = p.m;
-  q.data = p.data;
-  q.transitions.frames = p.n;
-  q.transitions.takes = p.m;
-  q.transitions.values = p.trans;
-  return q;
-}
 
 // Annotation-like data: each take has a piecewise-constant "liking" with noise, so that the best
 // take changes every few dozen frames and the constraint binds.
@@ -111,7 +101,7 @@ TEST(LabellingSemiMarkov, MatchesTextbookDpAtMediumSize) {
       LabellingOptions options;
       options.mu = mu;
       options.min_segment_length = d;
-      const LabellingResult r = SolveLabelling(ToProblem(p), options);
+      const LabellingResult r = SolveLabelling(ToLabellingProblem(p), options);
       const double expected = oracle::SemiMarkovOptimum(p, mu, d);
       ++instances;
 
@@ -147,7 +137,7 @@ TEST(LabellingSemiMarkov, NearlyInfeasibleConstraint) {
     LabellingOptions options;
     options.mu = 1.0;
     options.min_segment_length = d;
-    const LabellingResult r = SolveLabelling(ToProblem(p), options);
+    const LabellingResult r = SolveLabelling(ToLabellingProblem(p), options);
     const double expected = oracle::SemiMarkovOptimum(p, 1.0, d);
     EXPECT_TRUE(r.feasible);
     EXPECT_TRUE(NearRel(r.total_cost, expected))
