@@ -161,11 +161,11 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
       "0\0 \0"
       "0\0",
       8);
-  const std::string garbage = std::string(
-                                  "\x7F"
-                                  "ELF\x02\x01\x01\0\0\0\0\0",
-                                  16) +
-                              "\xDE\xAD";
+  // An ELF header's first 12 bytes, zeros included (sizeof counts the literal's terminator).
+  static constexpr char kElfStart[] =
+      "\x7F"
+      "ELF\x02\x01\x01\0\0\0\0\0";
+  const std::string garbage = std::string(kElfStart, sizeof(kElfStart) - 1) + "\xDE\xAD";
   std::vector<BadInput> c = {
       // ---- Trajectories (TUM) -----------------------------------------------------------------
       {"tum: missing column",

@@ -146,7 +146,8 @@ TEST(GltfScene, LongTracksReadBackTheirTimesExactly) {
   }
   // Short tracks (6.6 s) need no extras.
   WriteGlb(dir / "short.glb", TrajectoryScene(mesh, RandomTrajectory(200, 4), {}));
-  const auto& extras = ParseGlb(test_util::ReadBytes(dir / "short.glb")).json["animations"][0]["extras"];
+  const test_util::Glb short_glb = ParseGlb(test_util::ReadBytes(dir / "short.glb"));
+  const auto& extras = short_glb.json["animations"][0]["extras"];
   EXPECT_FALSE(extras.contains("mmh_frame_periods_s") || extras.contains("mmh_times_s"));
   test_util::ExpectValidGltf({dir / "even.glb", dir / "uneven.glb"});
 }
