@@ -98,6 +98,7 @@ void ProxyTrackerOptions::Validate(const std::string& prefix) const {
   motion.Validate(prefix + ".motion");
   detection.Validate(prefix + ".detection");
   verification.Validate(prefix + ".verification");
+  appearance.Validate(prefix + ".appearance");
 }
 
 struct ProxyTracker::Candidate {
@@ -335,7 +336,7 @@ struct ProxyTracker::DetectionRanking {
   std::optional<Rigid3> predicted;
   std::optional<Candidate> best;
   std::vector<Rigid3> refined_poses;
-  std::vector<std::pair<Rigid3, double>> verified;
+  std::vector<Candidate> verified;
 };
 
 namespace {
@@ -406,9 +407,7 @@ void ProxyTracker::Weigh(const RgbdFrame& frame, const IcpResult& refined,
                          DetectionRanking* ranking) const {
   Candidate candidate = Verify(frame, refined);
   if (Better(candidate, ranking->best, ranking->predicted)) ranking->best = candidate;
-  if (candidate.good) {
-    ranking->verified.emplace_back(candidate.icp.proxy_T_camera, candidate.Score());
-  }
+  if (candidate.good) ranking->verified.push_back(candidate);
 }
 
 void ProxyTracker::WeighDistinct(const RgbdFrame& frame, const IcpResult& refined,
@@ -487,19 +486,26 @@ void ProxyTracker::WeighTwins(const RgbdFrame& frame, const IcpOptions& coarse_i
   }
 }
 
-void ProxyTracker::SetDetectionRival(const DetectionRanking& ranking) {
+void ProxyTracker::SetDetectionRival(const RgbdFrame& frame, const DetectionRanking& ranking) {
   // The rival: the best-scoring verified pose more than 45 deg from the winner (a near-symmetric
   // twin that the data could not rule out), kept as the turn from the winner in the model's
-  // frame (proxy_T_rival) and carried along with the track (Track: the twin evidence).
+  // frame (proxy_T_rival) and carried along with the track (Track: the twin evidence). A twin
+  // whose colours agree min_gain worse than the winner's is ruled out (the appearance check).
   const Rigid3 camera_T_best = ranking.best->icp.proxy_T_camera.Inverse();
+  const std::optional<double> best_appearance = AppearanceAgreement(frame, camera_T_best);
   detection_rival_.reset();
   double rival_score = 0.0;
-  for (const auto& [proxy_T_camera, score] : ranking.verified) {
-    const Rigid3 camera_T_pose = proxy_T_camera.Inverse();
+  for (const Candidate& candidate : ranking.verified) {
+    const Rigid3 camera_T_pose = candidate.icp.proxy_T_camera.Inverse();
+    const double score = candidate.Score();
     if (RotationAngle(camera_T_pose.rotation, camera_T_best.rotation) <= std::numbers::pi / 4) {
       continue;
     }
     if (detection_rival_ && score <= rival_score) continue;
+    if (best_appearance) {
+      const std::optional<double> appearance = AppearanceAgreement(frame, camera_T_pose);
+      if (appearance && *appearance < *best_appearance - options_.appearance.min_gain) continue;
+    }
     detection_rival_ = camera_T_best.Inverse() * camera_T_pose;
     rival_score = score;
   }
@@ -540,11 +546,12 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
                   &ranking);
   }
   if (ranking.best && o.twins) WeighTwins(frame, coarse_icp, medium_scored, &ranking);
+  if (ranking.best) ChooseByAppearance(frame, &ranking);
   if (ranking.best) {
     ranking.best = Verify(
         frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
                                  ranking.best->icp.proxy_T_camera, search_icp_, sample_matches_));
-    SetDetectionRival(ranking);
+    SetDetectionRival(frame, ranking);
   }
   return ranking.best;
 }
@@ -628,7 +635,42 @@ ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
   score.explained = candidate.explained;
   score.score = candidate.Score();
   score.good = candidate.good;
+  if (appearance_) {
+    score.appearance = appearance_->Agreement(frame, score.camera_T_proxy, options_.appearance);
+  }
   return score;
+}
+
+void ProxyTracker::SetAppearanceModel(std::shared_ptr<const AppearanceModel> appearance) {
+  appearance_ = std::move(appearance);
+}
+
+std::optional<double> ProxyTracker::AppearanceAgreement(const RgbdFrame& frame,
+                                                        const Rigid3& camera_T_proxy) const {
+  if (!appearance_ || options_.appearance.margin <= 0) return std::nullopt;
+  return appearance_->Agreement(frame, camera_T_proxy, options_.appearance);
+}
+
+void ProxyTracker::ChooseByAppearance(const RgbdFrame& frame, DetectionRanking* ranking) const {
+  // The depth's winner stands unless a verified pose the depth scores as well (within margin)
+  // shows the model's colours where the image has them, min_gain better than the winner does.
+  if (!ranking->best->good) return;
+  const std::optional<double> best =
+      AppearanceAgreement(frame, ranking->best->icp.proxy_T_camera.Inverse());
+  if (!best) return;
+  const double best_score = ranking->best->Score();
+  double chosen_agreement = *best + options_.appearance.min_gain;
+  const Candidate* chosen = nullptr;
+  for (const Candidate& candidate : ranking->verified) {
+    if (candidate.Score() < best_score - options_.appearance.margin) continue;
+    const std::optional<double> agreement =
+        AppearanceAgreement(frame, candidate.icp.proxy_T_camera.Inverse());
+    if (agreement && *agreement > chosen_agreement) {
+      chosen_agreement = *agreement;
+      chosen = &candidate;
+    }
+  }
+  if (chosen) ranking->best = *chosen;
 }
 
 size_t ProxyTracker::PrepareMediumData() {

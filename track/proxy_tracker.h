@@ -18,6 +18,7 @@
 #include "core/rgbd_frame.h"
 #include "core/rigid3.h"
 #include "core/triangle_mesh.h"
+#include "track/appearance.h"
 #include "track/motion_model.h"
 #include "track/point_to_plane_icp.h"
 #include "track/projective_refinement.h"
@@ -228,6 +229,9 @@ struct ProxyTrackerOptions {
   MotionOptions motion;
   DetectionOptions detection;
   VerificationOptions verification;
+  // The colour check among the depth's equivalent poses (track/appearance.h; off by default, and
+  // then without effect: it needs SetAppearanceModel).
+  AppearanceOptions appearance;
 
   template <class V>
   void VisitFields(V& v) {
@@ -239,6 +243,7 @@ struct ProxyTrackerOptions {
     v("motion", motion);
     v("detection", detection);
     v("verification", verification);
+    v("appearance", appearance);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -277,6 +282,10 @@ class ProxyTracker {
   // object; a loss after that detects as usual.
   void Initialize(const Rigid3& camera_T_proxy);
 
+  // The coloured model of the appearance check (AppearanceOptions; in the model's frame). Without
+  // one, or with appearance.margin 0, detections rank by the depth alone.
+  void SetAppearanceModel(std::shared_ptr<const AppearanceModel> appearance);
+
   // Tracks one frame. Never throws for a bad frame: a frame of the wrong size, with other
   // intrinsics than the first, without depth or without a table is lost with the reason.
   TrackFrameResult Track(const RgbdFrame& frame);
@@ -290,6 +299,9 @@ class ProxyTracker {
     Rigid3 camera_T_proxy;
     double inlier_share = 0.0, rms = 0.0, free_space_violation = 0.0, explained = 0.0, score = 0.0;
     bool good = false;
+    // The appearance model's agreement with the colour image at the refined pose (nullopt without
+    // a model or with too few samples seen).
+    std::optional<double> appearance;
   };
   PoseScore ScorePose(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
 
@@ -370,7 +382,13 @@ class ProxyTracker {
   std::vector<Rigid3> MotionSeeds(const std::optional<Rigid3>& predicted) const;
   void WeighTwins(const RgbdFrame& frame, const IcpOptions& coarse_icp, size_t medium_scored,
                   DetectionRanking* ranking) const;
-  void SetDetectionRival(const DetectionRanking& ranking);
+  void SetDetectionRival(const RgbdFrame& frame, const DetectionRanking& ranking);
+  // The appearance check (AppearanceOptions): among ranking's verified poses within margin of the
+  // best's score, the one whose colours agree best replaces the best when it agrees min_gain
+  // better. A pose's agreement, when the check is on (nullopt otherwise, or too few samples).
+  void ChooseByAppearance(const RgbdFrame& frame, DetectionRanking* ranking) const;
+  std::optional<double> AppearanceAgreement(const RgbdFrame& frame,
+                                            const Rigid3& camera_T_proxy) const;
   // The detection among the model-sized segments (DetectionOptions::model_segments); leaves
   // segmentation_ and data_ holding the winner's segment.
   std::optional<Candidate> DetectAmongSegments(const RgbdFrame& frame,
@@ -394,6 +412,7 @@ class ProxyTracker {
   ProxyTrackerOptions options_;
   TrackSetup setup_;
   std::unique_ptr<ProxyModel> model_;
+  std::shared_ptr<const AppearanceModel> appearance_;
   Segmenter segmenter_;
   Segmentation segmentation_;
   std::optional<PinholeIntrinsics> intrinsics_;

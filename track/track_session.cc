@@ -9,6 +9,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/error_text.h"
+#include "core/mesh_io.h"
 #include "core/tum_io.h"
 #include "track/table_plane.h"
 
@@ -25,6 +26,39 @@ std::span<const std::pair<TrackInit, const char*>> EnumNames(TrackInit) {
                                                                  {TrackInit::kTruth, "truth"}};
   return kNames;
 }
+
+namespace {
+
+// The appearance check's model (TrackOptions::appearance_model): the file's, else the tracked
+// model's own colours when the check is on; nullptr when neither is asked for. A file whose size
+// differs from the model's by more than half (another unit, another object) is an InputError.
+std::shared_ptr<const AppearanceModel> LoadAppearanceModel(const TriangleMesh& model,
+                                                           const std::string& model_name,
+                                                           const TrackConfig& config) {
+  const std::string& path = config.track.appearance_model;
+  if (path.empty()) {
+    if (config.tracker.appearance.margin <= 0) return nullptr;
+    return std::make_shared<const AppearanceModel>(
+        model, "--model " + model_name + " (tracker.appearance.margin > 0 and no "
+                   "track.appearance_model: the model's own colours)");
+  }
+  const std::string where = "track.appearance_model " + path;
+  const TriangleMesh coloured = LoadMesh(path, config.track.model_scale);
+  auto size = [](const TriangleMesh& mesh) {
+    const Bounds3 b = ComputeBounds(mesh);
+    return b.empty() ? 0.0 : (b.max - b.min).norm();
+  };
+  const double model_size = size(model), coloured_size = size(coloured);
+  if (!(coloured_size >= model_size / 1.5 && coloured_size <= model_size * 1.5)) {
+    throw InputError(where + ": the appearance model is " + FormatNumber(coloured_size) +
+                     " m across (bounding-box diagonal, at track.model_scale " +
+                     FormatNumber(config.track.model_scale) + "), expected within a factor 1.5 of "
+                     "--model's " + FormatNumber(model_size) + " m (the same object, frame and unit)");
+  }
+  return std::make_shared<const AppearanceModel>(coloured, where);
+}
+
+}  // namespace
 
 void TrackOptions::Validate(const std::string& prefix) const {
   RequirePositive(model_scale, prefix + ".model_scale");
@@ -199,6 +233,9 @@ TrackRun RunTracking(FrameSource& source, const TriangleMesh& model, const std::
     if (config.track.play_area_width > 0) tracked_setup.play_area_width = config.track.play_area_width;
     if (config.track.play_area_depth > 0) tracked_setup.play_area_depth = config.track.play_area_depth;
     tracker.emplace(model, model_name, tracked_setup, config.tracker);
+    if (auto appearance = LoadAppearanceModel(model, model_name, config)) {
+      tracker->SetAppearanceModel(std::move(appearance));
+    }
     if (config.track.init == TrackInit::kTruth && initial_camera_T_proxy) {
       tracker->Initialize(*initial_camera_T_proxy);
     }

@@ -69,6 +69,11 @@ struct TrackOptions {
   // A model larger than this [m, bounding-box diagonal after model_scale] is an input error: a
   // model in millimetres read as metres (1000 times too big) is the usual cause.
   double max_model_size = 3.0;
+  // The appearance check's coloured model (tracker.appearance, track/appearance.h): a mesh file
+  // (PLY with vertex colours, OBJ with vertex or Kd colours) in --model's frame and unit
+  // (model_scale applies), e.g. a textured scan baked to vertex colours beside a plain geometric
+  // model. "" (default): --model's own colours, needed only when tracker.appearance.margin > 0.
+  std::string appearance_model;
 
   template <class V>
   void VisitFields(V& v) {
@@ -85,6 +90,7 @@ struct TrackOptions {
     v("play_area_width", play_area_width);
     v("play_area_depth", play_area_depth);
     v("max_model_size", max_model_size);
+    v("appearance_model", appearance_model);
   }
   void Validate(const std::string& prefix) const;
 };

@@ -193,6 +193,78 @@ TEST(RealRecordingCliTest, TracksTheMugWithItsScannedMesh) {
   EXPECT_LE(without.recall_5deg_5cm, 0.5);
 }
 
+// The gelatin box with its real shape (the hull of the dataset's points) is found turned over from
+// its own detection: its half turns fill the same space and the depth cannot tell them apart.
+// tracker.appearance with the YCB scan's colours (models_real/009_gelatin_box_colour.ply,
+// PROVENANCE.md) picks, among the poses the depth scores alike, the one whose printed texture
+// agrees with the colour image. Not yet run (docs/tracker.md, "The gelatin box's colours": the
+// bounds are the issue's goals and the real hull's figures from the truth's first pose, 1.54 deg /
+// 0.89 mm, AR 1.0; without the option 178.2 deg / 8.05 mm, AR 0.333).
+TEST(RealRecordingCliTest, TurnsTheGelatinBoxRightSideUpByItsColours) {
+  TempDir dir;
+  const std::string colours = "--set track.appearance_model=\\\"" +
+                              (kReal / "models_real" / "009_gelatin_box_colour.ply").string() +
+                              "\\\" --set tracker.appearance.margin=0.05";
+  // From either start: the medians below 3 deg and 2.5 mm, 90 % within 5 deg / 5 cm, AR 0.95.
+  for (const std::string init : {"detection", "truth"}) {
+    SCOPED_TRACE(init);
+    const Scores scores =
+        TrackAndEval(dir, 8, "models_real/009_gelatin_box.obj", init, kVideo, colours);
+    EXPECT_LT(scores.median_rotation_deg, 3.0);
+    EXPECT_LT(scores.median_translation_mm, 2.5);
+    EXPECT_GE(scores.recall_5deg_5cm, 0.9);
+    EXPECT_GE(scores.ar, 0.95);
+  }
+  // The option's reason: without it the box is turned over (178 deg).
+  TempDir off;
+  EXPECT_GT(TrackAndEval(off, 8, "models_real/009_gelatin_box.obj", "detection").median_rotation_deg,
+            90.0);
+}
+
+// The header of an ASCII PLY with vertex colours (x y z red green blue) and triangles (12 lines).
+std::string ColourPly(int vertices, int faces) {
+  return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+         "property uchar green\nproperty uchar blue\nelement face " + std::to_string(faces) +
+         "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+// A colour model that cannot serve: exit code 2 naming the file and what is wrong with it.
+TEST(RealRecordingCliTest, BadAppearanceModelsNameTheFileAndTheValue) {
+  TempDir dir;
+  const std::string track = "track --input " + kVideo.string() + " --model " +
+                            (kReal / "models_real" / "009_gelatin_box.obj").string() +
+                            " --config " + kPreset + " --set track.object=8 --set track.max_frames=1 ";
+  auto run = [&](const std::string& model, const std::string& out) {
+    return RunMmh(track + "--set tracker.appearance.margin=0.05 --set track.appearance_model=\\\"" +
+                  model + "\\\" --out " + (dir / out).string());
+  };
+  // A model without colours (the hull itself).
+  const auto plain = run((kReal / "models_real" / "009_gelatin_box.obj").string(), "a");
+  EXPECT_EQ(plain.exit_code, 2) << plain.output;
+  EXPECT_THAT(plain.output, HasSubstr("009_gelatin_box.obj: the appearance model has no colours"));
+  // The option on without a colour model: the tracked model's own colours, which it has not.
+  const auto none = RunMmh(track + "--set tracker.appearance.margin=0.05 --out " +
+                           (dir / "b").string());
+  EXPECT_EQ(none.exit_code, 2) << none.output;
+  EXPECT_THAT(none.output, HasSubstr("no track.appearance_model"));
+  // A colour out of its type's range (line 14 of an ASCII PLY: the second vertex).
+  WriteText(dir / "bad.ply", ColourPly(3, 1) + "0 0 0 255 0 0\n0.08 0 0 300 0 0\n"
+                                             "0 0.09 0.03 0 0 255\n3 0 1 2\n");
+  const auto range = run((dir / "bad.ply").string(), "c");
+  EXPECT_EQ(range.exit_code, 2) << range.output;
+  EXPECT_THAT(range.output, HasSubstr("bad.ply:14: vertex 1"));
+  EXPECT_THAT(range.output, HasSubstr("got '300' for property 'red', expected an integer of type uchar"));
+  // A colour model in millimetres (the tracked model is in metres).
+  WriteText(dir / "mm.ply", ColourPly(4, 2) + "0 0 0 255 0 0\n73 0 0 255 0 0\n"
+                                            "0 89 30 255 255 255\n73 89 30 255 255 255\n"
+                                            "3 0 1 2\n3 1 3 2\n");
+  const auto mm = run((dir / "mm.ply").string(), "d");
+  EXPECT_EQ(mm.exit_code, 2) << mm.output;
+  EXPECT_THAT(mm.output, HasSubstr("mm.ply: the appearance model is 11"));
+  EXPECT_THAT(mm.output, HasSubstr("expected within a factor 1.5 of --model's 0.1"));
+}
+
 // The real preset's 3 cm cut would hide the gelatin box (27 mm thin) lying flat: `mmh track` warns
 // on stderr and in track_summary.json, naming the option and the thickness; the run goes on.
 TEST(RealRecordingCliTest, WarnsWhenTheMinHeightHidesTheModelLyingFlat) {

@@ -15,18 +15,18 @@
 # source repository's mug_visual.obj:
 #   blender -b --factory-startup --python make_mug_model.py -- /path/to/mug_visual.obj
 # Deterministic: the same inputs give the same file.
-import math
 import os
 import sys
 
 import bmesh
 import bpy
 import numpy as np
-from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from scan_fit import distances, fit_points_to_scan, summary
+
 TARGET_FACES = 4096
-ICP_ITERATIONS = 40
 
 
 def read_obj(path):
@@ -40,54 +40,12 @@ def read_obj(path):
     return np.array(vertices), faces
 
 
-def distances(tree, points):
-    return np.array([(tree.find_nearest(Vector(p))[0] - Vector(p)).length for p in points])
-
-
-def closest(tree, points):
-    return np.array([tuple(tree.find_nearest(Vector(p))[0]) for p in points])
-
-
-def kabsch(a, b):
-    """The rotation and translation that move points a onto b (least squares)."""
-    ca, cb = a.mean(0), b.mean(0)
-    u, _, wt = np.linalg.svd((a - ca).T @ (b - cb))
-    d = np.diag([1.0, 1.0, np.sign(np.linalg.det(wt.T @ u.T))])
-    r = wt.T @ d @ u.T
-    return r, cb - r @ ca
-
-
-def summary(d):
-    return "mean %.3f mm, RMS %.3f mm, 99th percentile %.3f mm, max %.3f mm" % (
-        1e3 * d.mean(), 1e3 * math.sqrt((d ** 2).mean()), 1e3 * np.percentile(d, 99), 1e3 * d.max())
-
-
 source = sys.argv[sys.argv.index("--") + 1]
 scan_vertices, scan_faces = read_obj(source)
 points = np.loadtxt(os.path.join("models_real", "points", "025_mug.xyz"))
-scan_tree = BVHTree.FromPolygons([tuple(v) for v in scan_vertices], scan_faces)
 
 # 1. points (YCB-Video frame) -> scan frame: x_scan = r @ x + t.
-best = None
-scan_mid = (scan_vertices.min(0) + scan_vertices.max(0)) / 2
-points_mid = (points.min(0) + points.max(0)) / 2
-for flip in (1, -1):
-    for k in range(8):
-        a = k * math.pi / 4
-        r = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]]) @ np.diag(
-            [1, flip, flip])
-        t = scan_mid - r @ points_mid
-        for _ in range(ICP_ITERATIONS):
-            moved = points @ r.T + t
-            dr, dt = kabsch(moved, closest(scan_tree, moved))
-            r, t = dr @ r, dr @ t + dt
-        d = distances(scan_tree, points @ r.T + t)
-        if best is None or d.mean() < best[0]:
-            best = (d.mean(), r, t, flip, k)
-_, r, t, flip, k = best
-angle = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(r) - 1) / 2))))
-print("fit from start %d/%d: turn %.4f deg, translation (%.3f, %.3f, %.3f) mm (YCB-Video -> scan)" %
-      (flip, k, angle, *(1e3 * t)))
+r, t = fit_points_to_scan(points, scan_vertices, scan_faces)
 
 # 2. The scan in the YCB-Video frame (x = r^T (x_scan - t)), decimated.
 moved_vertices = (scan_vertices - t) @ r
