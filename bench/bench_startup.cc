@@ -119,6 +119,35 @@ void BM_Stats(benchmark::State& state) {
 }
 BENCHMARK(BM_Stats)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// A whole fast-fidelity command, `mmh run` on configs/soldier.json (3 Soldier takes: the error
+// model on the ground truth, both montages, montage.glb) or `mmh study` on
+// configs/study_soldier.json (20 animators, one study), in the light mmh and in mmh-full: the same
+// work and bytes (StartupTest), so the difference is the start-up. --threads 1 and run.metrics
+// off, as a study replicate or a sweep cell runs.
+void Fast(benchmark::State& state, const std::string& executable, const std::string& command,
+          const std::string& config) {
+  const fs::path out =
+      fs::temp_directory_path() / ("mmh_bench_" + command + "_" + std::to_string(getpid()));
+  Measure(state, {executable, command, "--config", config, "--set", "run.fidelity=\"fast\"",
+                  "--set", "run.metrics=false", "--threads", "1", "--quiet", "--out",
+                  out.string()});
+  fs::remove_all(out);
+}
+void BM_RunFast(benchmark::State& state) { Fast(state, Mmh(), "run", "configs/soldier.json"); }
+BENCHMARK(BM_RunFast)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_RunFastFull(benchmark::State& state) {
+  Fast(state, MmhFull(), "run", "configs/soldier.json");
+}
+BENCHMARK(BM_RunFastFull)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_StudyFast(benchmark::State& state) {
+  Fast(state, Mmh(), "study", "configs/study_soldier.json");
+}
+BENCHMARK(BM_StudyFast)->Unit(benchmark::kMillisecond)->UseRealTime();
+void BM_StudyFastFull(benchmark::State& state) {
+  Fast(state, MmhFull(), "study", "configs/study_soldier.json");
+}
+BENCHMARK(BM_StudyFastFull)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // A sweep worker running one compose cell: start-up, reading the plan, the cell (compose on the 4
 // example takes, in-process) and its bookkeeping. The cell's folder is removed between runs (a
 // worker skips complete cells).

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cli/command_registry.h"
+#include "pipeline/animator_run.h"
 
 namespace mmh::cli {
 
@@ -48,6 +49,12 @@ void ExecFullExecutable(const std::vector<std::string>& args) {
             << " does not have; it is built beside "
             << self.filename().string() << " (./mmh build)\n";
   std::exit(1);
+}
+
+void RequireFidelityHere(bool full_fidelity, const std::vector<std::string>& args) {
+  if (full_fidelity && !pipeline::FullFidelityLinked()) {
+    ExecFullExecutable(args);
+  }
 }
 
 }  // namespace mmh::cli

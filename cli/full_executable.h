@@ -32,4 +32,10 @@ inline constexpr const char* kFullExecutableName = "mmh-full";
 // same arguments (argv[0] included). If that fails: prints why and exits with 1.
 [[noreturn]] void ExecFullExecutable(const std::vector<std::string>& args);
 
+// Hands the command to mmh-full (ExecFullExecutable(args)) when it runs in full fidelity and this
+// program does not link the recorded sessions (pipeline::FullFidelityLinked): the light `mmh`
+// runs `run` and `study` in fast fidelity itself. Called once the config is read and checked, so
+// both programs report bad configs alike.
+void RequireFidelityHere(bool full_fidelity, const std::vector<std::string>& args);
+
 }  // namespace mmh::cli

@@ -10,6 +10,7 @@
 
 #include "cli/command_registry.h"
 #include "cli/common_flags.h"
+#include "cli/full_executable.h"
 #include "cli/provenance.h"
 #include "core/config.h"
 #include "core/error.h"
@@ -58,6 +59,7 @@ void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
   if (args.seed >= 0) config.Set("population.seed=" + std::to_string(args.seed));
   if (args.animator >= 0) config.Set("scenario.animator=" + std::to_string(args.animator));
   const pipeline::RunConfig run_config = pipeline::RunConfig::FromConfig(config);
+  RequireFidelityHere(run_config.run.fidelity == pipeline::Fidelity::kFull, argv);
   const auto threads = LimitThreads(args.common.threads);
   const std::filesystem::path out = args.common.out_dir;
   const bool bar = ShowProgress(args.common);

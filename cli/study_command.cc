@@ -9,6 +9,7 @@
 
 #include "cli/command_registry.h"
 #include "cli/common_flags.h"
+#include "cli/full_executable.h"
 #include "cli/provenance.h"
 #include "core/config.h"
 #include "core/json_text.h"
@@ -34,6 +35,7 @@ void RunStudy(const StudyArgs& args, const std::vector<std::string>& argv) {
   if (args.replicates > 0) config.Set("study.replicates=" + std::to_string(args.replicates));
   const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
   study_config.study.Validate("study");
+  RequireFidelityHere(study_config.run.run.fidelity == pipeline::Fidelity::kFull, argv);
   const nlohmann::json paper = ReadJsonFile(args.paper_reported);
   const auto threads = LimitThreads(args.common.threads);
 

@@ -14,7 +14,10 @@
 #include "cli/command_registry.h"
 #include "cli/common_flags.h"
 #include "cli/full_executable.h"
+#include "core/config.h"
 #include "core/error.h"
+#include "pipeline/animator_run.h"
+#include "sweep/command_config.h"
 #include "sweep/aggregate.h"
 #include "sweep/cell_store.h"
 #include "sweep/local_backend.h"
@@ -72,10 +75,31 @@ int Aggregate(const fs::path& dir, bool quiet) {
   return a.failed > 0 ? 1 : 0;
 }
 
-// The light mmh runs compose sweeps; the cells of other commands, and planning them, need the
-// renderer or the tracker: mmh-full takes over with the same arguments (cli/full_executable.h).
+// The light mmh runs compose sweeps and run and study sweeps in fast fidelity; the cells of track
+// and of run and study in full fidelity need the renderer or the tracker: mmh-full takes over
+// with the same arguments (cli/full_executable.h), and its workers are then mmh-full's.
 void RequireCommandHere(sweep::SweepCommand command, const std::vector<std::string>& argv) {
   if (!HasCommand(sweep::CommandName(command))) ExecFullExecutable(argv);
+}
+
+// Hands over to mmh-full when one of `cells` renders and tracks frames and this program cannot
+// (pipeline::FullFidelityLinked). Each cell's config (DIR/configs/ID.json, written by WritePlan)
+// is resolved as the cell will resolve it.
+void RequireCellsFidelityHere(const sweep::Plan& plan, const fs::path& dir,
+                              const std::vector<int>& cells,
+                              const std::vector<std::string>& argv) {
+  if (pipeline::FullFidelityLinked()) return;
+  for (const int c : cells) {
+    const Config config = Config::Load(sweep::CellConfigPath(dir, plan.cells.at(c)));
+    const nlohmann::json resolved = sweep::ResolveCommandConfig(plan.spec.command, config);
+    if (sweep::NeedsFullFidelity(plan.spec.command, resolved)) ExecFullExecutable(argv);
+  }
+}
+
+std::vector<int> AllCells(const sweep::Plan& plan) {
+  std::vector<int> cells(plan.cells.size());
+  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = static_cast<int>(i);
+  return cells;
 }
 
 void RunSweep(const SweepArgs& args, const std::vector<std::string>& argv) {
@@ -93,6 +117,7 @@ void RunSweep(const SweepArgs& args, const std::vector<std::string>& argv) {
   sweep::SlurmOptions slurm = spec.slurm;
   if (args.backend == "slurm") sweep::RequireSlurm(args.slurm_bin, args.dry_run);
   sweep::WritePlan(dir, plan);
+  if (!args.dry_run) RequireCellsFidelityHere(plan, dir, AllCells(plan), argv);
   if (args.dry_run && !args.common.quiet) {
     PrintCells(plan);
     std::printf("%zu cells (%d settings x %d replicates); plan written to %s/plan.json\n",
@@ -149,6 +174,7 @@ void RunWorker(const SweepArgs& args, const std::vector<std::string>& argv) {
       start = comma + 1;
     }
   }
+  RequireCellsFidelityHere(plan, dir, cells, argv);
   sweep::RunWorker(plan, dir, cells, options, RunInProcess);
 }
 

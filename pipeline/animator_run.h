@@ -164,6 +164,11 @@ using TakeLoader = std::function<bool(TakeRun& take, bool practice)>;
 AnimatorRun RunAnimator(const RunConfig& config, const Progress& progress = {},
                         const TakeDone& take_done = {}, const TakeLoader& load = {});
 
+// Whether this program can run full fidelity: it links the recorded sessions
+// (pipeline/recorded_sessions.h; the light `mmh` does not, and hands such runs to `mmh-full`).
+// RunAnimator throws a std::logic_error for run.fidelity = "full" where this is false.
+bool FullFidelityLinked();
+
 // A failure of the work (exit code 1), as opposed to bad input.
 class RunError : public std::runtime_error {
  public:

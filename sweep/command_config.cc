@@ -8,6 +8,8 @@
 #include "core/error.h"
 #include "core/options.h"
 #include "montage/compose.h"
+#include "pipeline/animator_run.h"
+#include "study/simulated_study.h"
 
 namespace mmh::sweep {
 namespace {
@@ -48,10 +50,22 @@ bool RegisterConfigResolver(SweepCommand command, ConfigResolver resolver) {
 }
 
 nlohmann::json ResolveCommandConfig(SweepCommand command, const Config& config) {
-  if (command == SweepCommand::kCompose) {
-    // As `mmh compose` reads it (cli/compose_command.cc).
-    config.RequireOnlySections({"montage"});
-    return {{"montage", ToJson(config.Get<montage::ComposeOptions>("montage"))}};
+  switch (command) {
+    case SweepCommand::kCompose:
+      // As `mmh compose` reads it (cli/compose_command.cc).
+      config.RequireOnlySections({"montage"});
+      return {{"montage", ToJson(config.Get<montage::ComposeOptions>("montage"))}};
+    case SweepCommand::kRun:
+      // As cli/run_command.cc reads it.
+      return pipeline::RunConfig::FromConfig(config).ToJson();
+    case SweepCommand::kStudy: {
+      // As cli/study_command.cc reads it.
+      const study::StudyConfig study_config = study::StudyConfig::FromConfig(config);
+      study_config.study.Validate("study");
+      return study_config.ToJson();
+    }
+    case SweepCommand::kTrack:
+      break;
   }
   const auto it = Resolvers().find(command);
   if (it == Resolvers().end()) {
@@ -59,6 +73,15 @@ nlohmann::json ResolveCommandConfig(SweepCommand command, const Config& config) 
                            "` in this program (link mmh::sweep_resolvers)");
   }
   return it->second(config);
+}
+
+bool NeedsFullFidelity(SweepCommand command, const nlohmann::json& resolved) {
+  if (command != SweepCommand::kRun && command != SweepCommand::kStudy) return false;
+  const auto run = resolved.find("run");
+  if (run == resolved.end() || !run->contains("fidelity")) {
+    throw std::logic_error("NeedsFullFidelity: a resolved config without run.fidelity");
+  }
+  return run->at("fidelity") == EnumName(pipeline::Fidelity::kFull);
 }
 
 std::vector<std::string> CommandInputs(const SweepSpec& spec) {

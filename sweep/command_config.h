@@ -16,17 +16,22 @@ class Config;
 namespace mmh::sweep {
 
 // The config `mmh <command>` would resolve from `config`; InputError as the command would throw.
-// Compose is built in; run, study and track need a registered ConfigResolver (a std::logic_error
-// without one).
+// Compose, run and study are built in; track needs a registered ConfigResolver (a
+// std::logic_error without one).
 nlohmann::json ResolveCommandConfig(SweepCommand command, const Config& config);
 
-// How the configs of run, study and track are resolved. The code that reads them links the
-// renderer and the tracker (Embree, PCL, OpenCV, OpenImageIO), so it is not part of mmh::sweep:
+// How the config of track is resolved. The code that reads it links the tracker's frame sources
+// (OpenImageIO through its plugin, the readers of recordings), so it is not part of mmh::sweep:
 // sweep/command_resolvers.cc registers it at start-up, in the programs that link the object
-// library mmh::sweep_resolvers (mmh-full, the tests), and the light mmh, which runs compose
-// sweeps only, links none of it (docs/architecture.md, "Start-up").
+// library mmh::sweep_resolvers (mmh-full, the tests), and the light mmh, which runs compose,
+// run and study sweeps, links none of it (docs/architecture.md, "Start-up").
 using ConfigResolver = nlohmann::json (*)(const Config& config);
 bool RegisterConfigResolver(SweepCommand command, ConfigResolver resolver);
+
+// Whether a cell of `command` with this resolved config (ResolveCommandConfig) renders and tracks
+// frames: run and study in full fidelity (run.fidelity). The light mmh hands such sweeps to
+// mmh-full (cli/sweep_command.cc).
+bool NeedsFullFidelity(SweepCommand command, const nlohmann::json& resolved);
 
 // The command-line inputs of every cell from the spec's "inputs" (e.g. compose: takes,
 // annotations), checked: unknown inputs, missing required ones and missing files are InputErrors

@@ -84,19 +84,84 @@ TEST(StartupTest, OtherCommandsRunInMmhFullWithTheSameHelpErrorsAndExitCodes) {
   EXPECT_EQ(RunMmh("bogus").exit_code, 2);
 }
 
-TEST(StartupTest, SweepsOfHeavyCommandsArePlannedByMmhFull) {
-  // The spec's paths are relative to the project (as when run from it).
+// Every file of folder `a` (recursively) but the provenance and timings equals `b`'s.
+void ExpectSameResults(const fs::path& a, const fs::path& b) {
+  std::size_t files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(a)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path relative = fs::relative(entry.path(), a);
+    if (relative == "run.json" || relative == "timings.csv") continue;
+    ++files;
+    EXPECT_EQ(test_util::ReadBytes(entry.path()), test_util::ReadBytes(b / relative)) << relative;
+  }
+  EXPECT_GT(files, 5u) << a;
+}
+
+// The light mmh runs `run` and `study` in fast fidelity itself (no renderer, no tracker: the
+// error model on the ground truth), with the same bytes as mmh-full; full fidelity goes to
+// mmh-full. A copy of mmh without mmh-full beside it tells which program ran.
+TEST(StartupTest, FastRunsStudiesAndTheirSweepsRunInTheLightExecutable) {
+  // The configs' paths are relative to the project (as when run from it).
   fs::current_path(MMH_SOURCE_DIR);
   test_util::TempDir dir;
-  const auto r = RunMmh("sweep --spec " + std::string(MMH_SOURCE_DIR) +
-                        "/configs/sweeps/study_power.json --out " + (dir.path() / "s").string() +
-                        " --dry-run --quiet");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string plan = test_util::ReadBytes(dir.path() / "s" / "plan.json");
-  EXPECT_NE(plan.find("\"study\""), std::string::npos);
-  const auto status = RunMmh("sweep status " + (dir.path() / "s").string());
-  EXPECT_EQ(status.exit_code, 0) << status.output;
-  EXPECT_NE(status.output.find("15 cells"), std::string::npos) << status.output;
+  const fs::path alone = dir.path() / "mmh";
+  fs::copy_file(MMH_BINARY, alone);
+  const std::string fast = " --set 'run.fidelity=\"fast\"' --quiet --threads 1 --out ";
+  const std::string run = " run --config configs/soldier.json" + fast;
+  const auto light_run = Shell(alone.string() + run + (dir.path() / "run_light").string());
+  ASSERT_EQ(light_run.exit_code, 0) << light_run.output;
+  ASSERT_EQ(Shell(kFull.string() + run + (dir.path() / "run_full").string()).exit_code, 0);
+  ExpectSameResults(dir.path() / "run_light", dir.path() / "run_full");
+
+  const std::string study =
+      " study --config configs/study_soldier.json --set study.animators=6 --replicates 2" + fast;
+  const auto light_study = Shell(alone.string() + study + (dir.path() / "study_light").string());
+  ASSERT_EQ(light_study.exit_code, 0) << light_study.output;
+  ASSERT_EQ(Shell(kFull.string() + study + (dir.path() / "study_full").string()).exit_code, 0);
+  ExpectSameResults(dir.path() / "study_light", dir.path() / "study_full");
+
+  // A sweep of fast run cells: planned and its first cell run by the light worker.
+  const fs::path sweep = dir.path() / "sweep_fast";
+  const auto plan = Shell(alone.string() + " sweep --spec configs/sweeps/montage_quality.json" +
+                          " --dry-run --quiet --out " + sweep.string());
+  ASSERT_EQ(plan.exit_code, 0) << plan.output;
+  const auto worker = Shell(alone.string() + " sweep worker " + sweep.string() + " --cells 0");
+  EXPECT_EQ(worker.exit_code, 0) << worker.output;
+  const auto status = Shell(alone.string() + " sweep status " + sweep.string());
+  EXPECT_NE(status.output.find("1 done, 0 failed"), std::string::npos) << status.output;
+
+  // Full fidelity (the configs' default) needs mmh-full: a run, a study and a sweep of full-
+  // fidelity run cells each say that they cannot start it, and write nothing.
+  const std::string missing = "cannot start " + (dir.path() / "mmh-full").string();
+  for (const std::string& args :
+       {"run --config configs/soldier.json --quiet --out " + (dir.path() / "run_ff").string(),
+        "study --config configs/study_soldier.json --quiet --out " +
+            (dir.path() / "study_ff").string(),
+        "sweep --spec configs/sweeps/tracking_noise.json --quiet --out " +
+            (dir.path() / "sweep_ff").string()}) {
+    const auto r = Shell(alone.string() + " " + args);
+    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_NE(r.output.find(missing), std::string::npos) << args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "run_ff"));
+  EXPECT_FALSE(fs::exists(dir.path() / "study_ff"));
+  EXPECT_FALSE(fs::exists(dir.path() / "sweep_ff" / "cells"));
+}
+
+TEST(StartupTest, SweepsOfTrackArePlannedByMmhFull) {
+  fs::current_path(MMH_SOURCE_DIR);
+  test_util::TempDir dir;
+  const fs::path alone = dir.path() / "mmh";
+  fs::copy_file(MMH_BINARY, alone);
+  test_util::WriteText(dir.path() / "track.json",
+                       R"({"command": "track", "inputs": {"input": "examples/synthetic_story"},
+                          "axes": [{"key": "tracker.icp.iterations", "values": [10, 20]}],
+                          "metrics": [{"name": "m", "file": "metrics.json", "key": "m"}]})");
+  const auto r = Shell(alone.string() + " sweep --spec " + (dir.path() / "track.json").string() +
+                       " --dry-run --quiet --out " + (dir.path() / "s").string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("cannot start " + (dir.path() / "mmh-full").string()), std::string::npos)
+      << r.output;
 }
 
 TEST(StartupTest, WithoutMmhFullTheLightCommandsStillRunAndTheOthersFailClearly) {
