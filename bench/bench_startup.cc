@@ -120,17 +120,19 @@ void BM_Stats(benchmark::State& state) {
 BENCHMARK(BM_Stats)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A whole fast-fidelity command, `mmh run` on configs/soldier.json (3 Soldier takes: the error
-// model on the ground truth, both montages, montage.glb) or `mmh study` on
-// configs/study_soldier.json (20 animators, one study), in the light mmh and in mmh-full: the same
-// work and bytes (StartupTest), so the difference is the start-up. --threads 1 and run.metrics
-// off, as a study replicate or a sweep cell runs.
+// model on the ground truth, both montages, metrics.json, montage.glb) or `mmh study` on
+// configs/study_soldier.json (20 animators, one study, run.metrics off as its replicates have
+// it), in the light mmh and in mmh-full: the same work and bytes (StartupTest), so the
+// difference is the start-up. One thread, as a sweep cell runs.
 void Fast(benchmark::State& state, const std::string& executable, const std::string& command,
           const std::string& config) {
   const fs::path out =
       fs::temp_directory_path() / ("mmh_bench_" + command + "_" + std::to_string(getpid()));
-  Measure(state, {executable, command, "--config", config, "--set", "run.fidelity=\"fast\"",
-                  "--set", "run.metrics=false", "--threads", "1", "--quiet", "--out",
-                  out.string()});
+  std::vector<std::string> args = {executable, command, "--config", config, "--set",
+                                   "run.fidelity=\"fast\"", "--threads", "1", "--quiet",
+                                   "--out", out.string()};
+  if (command == "study") args.insert(args.end(), {"--set", "run.metrics=false"});
+  Measure(state, args);
   fs::remove_all(out);
 }
 void BM_RunFast(benchmark::State& state) { Fast(state, Mmh(), "run", "configs/soldier.json"); }
