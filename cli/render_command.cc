@@ -3,7 +3,9 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
+#include <iterator>
 #include <memory>
+#include <optional>
 
 #include "cli/command_registry.h"
 #include "cli/common_flags.h"
@@ -11,6 +13,7 @@
 #include "core/atomic_file.h"
 #include "core/config.h"
 #include "core/error.h"
+#include "pipeline/depth_sequence.h"
 #include "sim/render_session.h"
 #include "sim/sensor_check_run.h"
 
@@ -57,6 +60,7 @@ void RunRender(const CommonFlags& common, const std::vector<std::string>& argv) 
 struct SensorCheckArgs {
   CommonFlags common;
   std::string data;
+  std::string sequence;
   int frames = 3;
 };
 
@@ -69,7 +73,12 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   }
   const sim::RenderConfig render = sim::RenderConfig::FromConfig(config);
   const auto threads = LimitThreads(args.common.threads);
-  const sim::SensorCheckReport report = sim::RunSensorCheck(args.data, render, args.frames);
+  std::optional<sim::DepthSequence> sequence;
+  if (!args.sequence.empty()) {
+    sequence = pipeline::ReadDepthSequence(args.sequence, std::end(sim::kTemporalLags)[-1] + 1);
+  }
+  const sim::SensorCheckReport report =
+      sim::RunSensorCheck(args.data, render, args.frames, sequence ? &*sequence : nullptr);
   std::cout << report.Format();
   if (!args.common.out_dir.empty()) {
     const std::filesystem::path out = args.common.out_dir;
@@ -103,6 +112,13 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
       "sensor-check",
       "Depth-step law, missing pixels and noise of real Kinect frames beside rendered ones");
   cmd->add_option("--data", args->data, "Folder with TUM_depth.png, NYU_depth.pgm, SUN_depth.png")
+      ->capture_default_str();
+  // YCB-Video's video 0000 (Asus Xtion, structured light; tests/data/real/ycbv/PROVENANCE.md): a
+  // nearly static view, for the temporal structure of the errors.
+  args->sequence = std::string(MMH_SOURCE_DIR) + "/tests/data/real/ycbv/data/0000";
+  cmd->add_option("--sequence", args->sequence,
+                  "Real recording (BOP, YCB-Video or TUM folder) of a nearly static view: the "
+                  "temporal structure of its errors; empty: none")
       ->capture_default_str();
   cmd->add_option("--frames", args->frames, "Rendered frames to analyse")
       ->check(CLI::Range(1, 1000));

@@ -20,6 +20,91 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 using internal::Median;
 using internal::ValidDepth;
 
+// A fully valid patch_size window of a depth image with its least-squares plane
+// z = a u + b v + c: where it lies, its residuals, their sigma, the per-pixel model's sigma there
+// (when asked) and the plane's incidence.
+struct Patch {
+  int u0 = 0, v0 = 0;
+  Eigen::VectorXd residual;
+  double sigma = 0, model = 0, incidence_deg = 0;
+};
+
+// The patches of the image tiled by windows of patch_size, fully valid within [min_depth_m,
+// max_depth_m] and seen at no more than max_incidence_deg. `calibration` and `noise` give
+// Patch::model (left 0 without them).
+std::vector<Patch> PlanarPatches(const std::vector<float>& depth_m, int width, int height,
+                                 const PinholeIntrinsics& intrinsics,
+                                 const ErrorStructureOptions& options,
+                                 const KinectCalibration* calibration,
+                                 const AxialNoiseModel* noise) {
+  const int n = options.patch_size;
+  const double max_tan = std::tan(options.max_incidence_deg * std::numbers::pi / 180.0);
+  Eigen::MatrixXd design(n * n, 3);
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) design.row(j * n + i) << i - n / 2, j - n / 2, 1.0;
+  }
+  const Eigen::MatrixXd solve = (design.transpose() * design).inverse() * design.transpose();
+  std::vector<Patch> patches;
+  for (int v0 = 0; v0 + n <= height; v0 += n) {
+    for (int u0 = 0; u0 + n <= width; u0 += n) {
+      Eigen::VectorXd z(n * n);
+      bool full = true;
+      for (int j = 0; j < n && full; ++j) {
+        for (int i = 0; i < n; ++i) {
+          const float d = depth_m[static_cast<size_t>(v0 + j) * width + u0 + i];
+          if (!ValidDepth(d) || d < options.min_depth_m || d > options.max_depth_m) {
+            full = false;
+            break;
+          }
+          z[j * n + i] = d;
+        }
+      }
+      if (!full) continue;
+      const Eigen::Vector3d plane = solve * z;
+      const double zc = plane[2];
+      // Incidence: the plane's normal in the camera frame from its depth gradient (per pixel,
+      // dz/du = a, dz/dv = b; a pixel spans z / f metres).
+      const double gx = plane[0] * intrinsics.fx / zc, gy = plane[1] * intrinsics.fy / zc;
+      if (std::hypot(gx, gy) > max_tan) continue;
+      Patch p;
+      p.u0 = u0;
+      p.v0 = v0;
+      p.residual = z - design * plane;
+      p.sigma = std::sqrt(p.residual.squaredNorm() / (n * n - 3));
+      const double theta = std::atan(std::hypot(gx, gy));
+      if (calibration != nullptr && noise != nullptr) {
+        const double step = LatticeStep(zc, *calibration);
+        const double sigma_z = noise->Sigma(zc, theta);
+        p.model = std::sqrt(sigma_z * sigma_z + step * step / 12.0);
+      }
+      p.incidence_deg = theta * 180.0 / std::numbers::pi;
+      patches.push_back(std::move(p));
+    }
+  }
+  return patches;
+}
+
+// The patches whose residual sigma is at most outlier_factor times the median of all (windows
+// with an edge or a fold inside are left out).
+std::vector<const Patch*> InlierPatches(const std::vector<Patch>& patches,
+                                        const ErrorStructureOptions& options) {
+  std::vector<double> sigmas;
+  for (const Patch& p : patches) sigmas.push_back(p.sigma);
+  const double typical = Median(sigmas);
+  std::vector<const Patch*> inliers;
+  for (const Patch& p : patches) {
+    if (p.sigma <= options.outlier_factor * typical) inliers.push_back(&p);
+  }
+  return inliers;
+}
+
+void CheckDepthSize(const std::vector<float>& depth_m, int width, int height) {
+  if (width < 1 || height < 1 || depth_m.size() != static_cast<size_t>(width) * height) {
+    ThrowBadValue("depth", std::to_string(depth_m.size()) + " pixels",
+                  std::to_string(width) + "x" + std::to_string(height) + " pixels");
+  }
+}
+
 }  // namespace
 
 void ErrorStructureOptions::Validate(const std::string& prefix) const {
@@ -125,10 +210,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
                                      const AxialNoiseModel& noise,
                                      const ErrorStructureOptions& options) {
   options.Validate("error_structure");
-  if (width < 1 || height < 1 || depth_m.size() != static_cast<size_t>(width) * height) {
-    ThrowBadValue("depth", std::to_string(depth_m.size()) + " pixels",
-                  std::to_string(width) + "x" + std::to_string(height) + " pixels");
-  }
+  CheckDepthSize(depth_m, width, height);
   ErrorStructure s;
   const double pixels = static_cast<double>(width) * height;
   std::vector<double> shadow_runs, edge_runs;
@@ -144,60 +226,15 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   s.shadow_band_px = Median(shadow_runs);
   s.edge_band_px = Median(edge_runs);
 
-  // Planar patches: residuals of a least-squares plane z = a u + b v + c.
   const int n = options.patch_size;
   const int lags = n / 2;
-  const double max_tan = std::tan(options.max_incidence_deg * std::numbers::pi / 180.0);
-  Eigen::MatrixXd design(n * n, 3);
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) design.row(j * n + i) << i - n / 2, j - n / 2, 1.0;
-  }
-  const Eigen::MatrixXd solve = (design.transpose() * design).inverse() * design.transpose();
-  struct Patch {
-    Eigen::VectorXd residual;
-    double sigma, model, incidence_deg;
-  };
-  std::vector<Patch> patches;
-  for (int v0 = 0; v0 + n <= height; v0 += n) {
-    for (int u0 = 0; u0 + n <= width; u0 += n) {
-      Eigen::VectorXd z(n * n);
-      bool full = true;
-      for (int j = 0; j < n && full; ++j) {
-        for (int i = 0; i < n; ++i) {
-          const float d = depth_m[static_cast<size_t>(v0 + j) * width + u0 + i];
-          if (!ValidDepth(d) || d < options.min_depth_m || d > options.max_depth_m) {
-            full = false;
-            break;
-          }
-          z[j * n + i] = d;
-        }
-      }
-      if (!full) continue;
-      const Eigen::Vector3d plane = solve * z;
-      const double zc = plane[2];
-      // Incidence: the plane's normal in the camera frame from its depth gradient (per pixel,
-      // dz/du = a, dz/dv = b; a pixel spans z / f metres).
-      const double gx = plane[0] * intrinsics.fx / zc, gy = plane[1] * intrinsics.fy / zc;
-      if (std::hypot(gx, gy) > max_tan) continue;
-      Patch p;
-      p.residual = z - design * plane;
-      p.sigma = std::sqrt(p.residual.squaredNorm() / (n * n - 3));
-      const double theta = std::atan(std::hypot(gx, gy));
-      const double step = LatticeStep(zc, calibration);
-      const double sigma_z = noise.Sigma(zc, theta);
-      p.model = std::sqrt(sigma_z * sigma_z + step * step / 12.0);
-      p.incidence_deg = theta * 180.0 / std::numbers::pi;
-      patches.push_back(std::move(p));
-    }
-  }
-  std::vector<double> sigmas;
-  for (const Patch& p : patches) sigmas.push_back(p.sigma);
-  const double typical = Median(sigmas);
+  const std::vector<Patch> patches =
+      PlanarPatches(depth_m, width, height, intrinsics, options, &calibration, &noise);
   std::vector<double> numerator(lags + 1, 0.0), ratios;
   std::array<std::vector<double>, ErrorStructure::kIncidenceBins> ratios_by_incidence;
   double energy = 0;
-  for (const Patch& p : patches) {
-    if (!(p.sigma <= options.outlier_factor * typical)) continue;
+  for (const Patch* inlier : InlierPatches(patches, options)) {
+    const Patch& p = *inlier;
     ++s.patches;
     ratios.push_back(p.sigma / p.model);
     const int bin = std::min(ErrorStructure::kIncidenceBins - 1,
@@ -240,6 +277,41 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
     }
   }
   return s;
+}
+
+TemporalCorrelation AnalyseTemporalCorrelation(const std::vector<float>& a_m,
+                                               const std::vector<float>& b_m, int width,
+                                               int height, const PinholeIntrinsics& intrinsics,
+                                               const ErrorStructureOptions& options) {
+  options.Validate("error_structure");
+  CheckDepthSize(a_m, width, height);
+  CheckDepthSize(b_m, width, height);
+  const std::vector<Patch> patches_a =
+      PlanarPatches(a_m, width, height, intrinsics, options, nullptr, nullptr);
+  const std::vector<Patch> patches_b =
+      PlanarPatches(b_m, width, height, intrinsics, options, nullptr, nullptr);
+  // Both lists are in tiling order: a merge finds the windows kept in both frames.
+  const std::vector<const Patch*> a = InlierPatches(patches_a, options);
+  const std::vector<const Patch*> b = InlierPatches(patches_b, options);
+  auto order = [width](const Patch& p) { return static_cast<long>(p.v0) * width + p.u0; };
+  TemporalCorrelation t;
+  double ab = 0, aa = 0, bb = 0;
+  for (size_t i = 0, j = 0; i < a.size() && j < b.size();) {
+    if (order(*a[i]) < order(*b[j])) {
+      ++i;
+    } else if (order(*b[j]) < order(*a[i])) {
+      ++j;
+    } else {
+      ab += a[i]->residual.dot(b[j]->residual);
+      aa += a[i]->residual.squaredNorm();
+      bb += b[j]->residual.squaredNorm();
+      ++t.patches;
+      ++i;
+      ++j;
+    }
+  }
+  t.rho = aa > 0 && bb > 0 ? ab / std::sqrt(aa * bb) : kNaN;
+  return t;
 }
 
 nlohmann::json ToJson(const ErrorStructure& s) {

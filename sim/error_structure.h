@@ -68,6 +68,17 @@ struct ErrorStructure {
   double correlation_length_px = 0;
 };
 
+// The temporal structure: how much of a frame's residuals on planes the next frames of the same
+// view keep. A real block matcher's errors come from the speckle pattern on the surface, fixed
+// while neither moves, and from the IR image's noise, new in every frame; the per-pixel model's
+// are new in every frame.
+struct TemporalCorrelation {
+  // sum r_a r_b / sqrt(sum r_a^2 sum r_b^2) over the pixels of the windows kept in both frames
+  // (AnalyseErrorStructure's planar windows without outliers; NaN: none).
+  double rho = 0;
+  int patches = 0;
+};
+
 // depth_m: width x height row-major [m], 0 = missing; intrinsics for incidence angles.
 ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int width, int height,
                                      const PinholeIntrinsics& intrinsics,
@@ -76,6 +87,13 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
                                      const ErrorStructureOptions& options = {});
 
 nlohmann::json ToJson(const ErrorStructure& structure);
+
+// Two frames of one view (the same camera pose; a static scene, or its static part: windows on
+// moving objects are rarely planar in both at the same place).
+TemporalCorrelation AnalyseTemporalCorrelation(const std::vector<float>& a_m,
+                                               const std::vector<float>& b_m, int width,
+                                               int height, const PinholeIntrinsics& intrinsics,
+                                               const ErrorStructureOptions& options = {});
 
 // Why a pixel is missing, judged from the depth image alone (real frames carry no labels): runs of
 // missing pixels along a row touching the image's side (border), with the far side on their left

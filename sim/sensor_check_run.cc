@@ -1,11 +1,32 @@
 #include "sim/sensor_check_run.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <iterator>
+
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/image_io.h"
 #include "sim/kinect_sensor.h"
 
 namespace mmh::sim {
 namespace {
+
+// The first frame's residual correlation with the frames kTemporalLags later.
+SensorCheckReport::TemporalRow TemporalStructure(const std::string& name,
+                                                 const DepthSequence& sequence) {
+  SensorCheckReport::TemporalRow row{name, {}};
+  for (const int lag : kTemporalLags) {
+    if (lag >= static_cast<int>(sequence.depth_m.size())) {
+      ThrowBadValue(sequence.name + ": frames", std::to_string(sequence.depth_m.size()),
+                    "at least " + std::to_string(lag + 1) + " frames (the temporal structure)");
+    }
+    row.lags.push_back(AnalyseTemporalCorrelation(sequence.depth_m[0], sequence.depth_m[lag],
+                                                  sequence.width, sequence.height,
+                                                  sequence.intrinsics));
+  }
+  return row;
+}
 
 // The first `frames` frames of the demo walk in one sensor mode: every frame's statistics into
 // report.rendered_frames, the first frame's error structure (and, for structured light, its
@@ -20,17 +41,23 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
   KinectSensor sensor(sensor_options, &table_top.scene(), table_top.table_T_camera());
   sensor.KeepMissingCauses(structured);
   const std::size_t first = report.rendered_frames.size();
-  for (int i = 0; i < frames; ++i) {
+  const int last_lag = std::end(kTemporalLags)[-1];
+  std::vector<std::vector<float>> sequence;  // frames 0 .. last_lag, for the temporal structure
+  PinholeIntrinsics intrinsics;
+  for (int i = 0; i < std::max(frames, last_lag + 1); ++i) {
     const double t = i / config.sensor.frame_rate;
     table_top.SetFrame(config.motion.TableTProxy(t), config.motion.SliderValue(t));
     const RgbdFrame frame = sensor.Render(i);
     const int width = frame.depth_intrinsics.width;
     const int height = frame.depth_intrinsics.height;
+    intrinsics = frame.depth_intrinsics;
     SensorCheckOptions frame_options = options;
     frame_options.intrinsics = frame.depth_intrinsics;
     frame_options.calibration = config.sensor.calibration;
     frame_options.noise = config.sensor.axial;
     const std::vector<float> depth_m = DepthMetresFromUnits(frame.depth, frame.depth_scale);
+    if (i <= last_lag) sequence.push_back(depth_m);
+    if (i >= frames) continue;
     report.rendered_frames.push_back(
         ComputeSensorStatistics(name, depth_m, width, height, frame_options));
     if (i > 0) continue;
@@ -45,14 +72,20 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
                                             sensor.missing_causes());
     }
   }
+  report.temporal.push_back(TemporalStructure(
+      name, {name, intrinsics.width, intrinsics.height, intrinsics, std::move(sequence)}));
   return report.rendered_frames[first];
 }
 
 }  // namespace
 
 SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
-                                 const RenderConfig& config, int frames) {
+                                 const RenderConfig& config, int frames,
+                                 const DepthSequence* real_sequence) {
   SensorCheckReport report;
+  if (real_sequence != nullptr) {
+    report.temporal.push_back(TemporalStructure(real_sequence->name, *real_sequence));
+  }
   const SensorCheckOptions options;
   // Real frames: TUM (5000 units per metre), NYU raw disparity, SUN (millimetres).
   const DepthImage tum = ReadDepthPng16(real_frames / "TUM_depth.png");
@@ -85,9 +118,29 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
 }
 
 std::string SensorCheckReport::Format() const {
-  return FormatSensorTable(columns) + "\n" +
-         FormatRealismTable(structure_names, structures, 0, {2, 3}) + "\n" +
-         "structured light, first frame: " + cause_table;
+  std::string text = FormatSensorTable(columns) + "\n" +
+                     FormatRealismTable(structure_names, structures, 0, {2, 3}) + "\n" +
+                     "structured light, first frame: " + cause_table;
+  // The temporal structure: one row per sequence, rho and the windows at each lag.
+  text += "\nresidual correlation with the first frame (planar windows kept in both)\n";
+  char line[160];
+  std::snprintf(line, sizeof(line), "%-40s", "sequence");
+  text += line;
+  for (const int lag : kTemporalLags) {
+    std::snprintf(line, sizeof(line), "  lag %d: rho (windows)", lag);
+    text += line;
+  }
+  text += "\n";
+  for (const TemporalRow& row : temporal) {
+    std::snprintf(line, sizeof(line), "%-40s", row.name.c_str());
+    text += line;
+    for (const TemporalCorrelation& t : row.lags) {
+      std::snprintf(line, sizeof(line), "  %14.3f (%5d)", t.rho, t.patches);
+      text += line;
+    }
+    text += "\n";
+  }
+  return text;
 }
 
 nlohmann::json SensorCheckReport::ToJson() const {
@@ -99,7 +152,20 @@ nlohmann::json SensorCheckReport::ToJson() const {
   for (size_t k = 0; k < structures.size(); ++k) {
     error_structure[structure_names[k]] = sim::ToJson(structures[k]);
   }
-  return {{"columns", j}, {"rendered_frames", frames}, {"error_structure", error_structure}};
+  nlohmann::json temporal_json = nlohmann::json::array();
+  for (const TemporalRow& row : temporal) {
+    nlohmann::json lags = nlohmann::json::array();
+    for (size_t k = 0; k < row.lags.size(); ++k) {
+      lags.push_back({{"lag_frames", kTemporalLags[k]},
+                      {"rho", row.lags[k].rho},
+                      {"windows", row.lags[k].patches}});
+    }
+    temporal_json.push_back({{"sequence", row.name}, {"lags", lags}});
+  }
+  return {{"columns", j},
+          {"rendered_frames", frames},
+          {"error_structure", error_structure},
+          {"temporal_correlation", temporal_json}};
 }
 
 void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out) {

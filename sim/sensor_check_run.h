@@ -15,6 +15,19 @@
 
 namespace mmh::sim {
 
+// Frames of one real view over time (a recording of a nearly static scene), for the temporal
+// structure of its errors: depth [m] width x height row-major, at least kTemporalLags.back() + 1
+// frames.
+struct DepthSequence {
+  std::string name;
+  int width = 0, height = 0;
+  PinholeIntrinsics intrinsics;
+  std::vector<std::vector<float>> depth_m;
+};
+
+// Frame lags of the temporal correlation (AnalyseTemporalCorrelation against the first frame).
+inline constexpr int kTemporalLags[] = {1, 4};
+
 struct SensorCheckReport {
   // TUM real, NYU real, SUN real, then the first frame of each rendered mode.
   std::vector<SensorStatistics> columns;
@@ -31,6 +44,13 @@ struct SensorCheckReport {
   int width = 0, height = 0;
   std::vector<float> tum_depth_m;
   std::vector<float> rendered_depth_m[2];
+  // The temporal correlation of residuals at each of kTemporalLags: the real sequence (when
+  // given), then each rendered mode (the demo walk; the windows on the moving proxy rarely count).
+  struct TemporalRow {
+    std::string name;
+    std::vector<TemporalCorrelation> lags;  // one per kTemporalLags
+  };
+  std::vector<TemporalRow> temporal;
 
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
@@ -40,9 +60,12 @@ struct SensorCheckReport {
 
 // Reads TUM_depth.png, NYU_depth.pgm and SUN_depth.png from `real_frames` (InputError naming a
 // missing or unreadable file) and renders `frames` frames of `config`'s scene (the demo walk) in
-// both sensor modes.
+// both sensor modes (at least kTemporalLags.back() + 1 for the temporal structure, which the
+// statistics of frames beyond `frames` do not enter). `real_sequence`: a real recording's first
+// frames for the temporal structure (nullptr: none).
 SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
-                                 const RenderConfig& config, int frames);
+                                 const RenderConfig& config, int frames,
+                                 const DepthSequence* real_sequence = nullptr);
 
 // Writes sensor_check.json and, when the frames have the same size, sensor_check.png (TUM,
 // statistical, structured light side by side) into `out`.

@@ -142,6 +142,36 @@ TEST(ErrorStructure, CauseTableCountsEachClassAgainstEachCause) {
   EXPECT_THROW(FormatCauseTable(classes, std::vector<MissingCause>(3)), InputError);
 }
 
+// Two frames of a tilted plane sharing a fixed error f (the speckle pattern's) and each with its
+// own e (the IR noise's), white with equal variances: E[r_a r_b] / E[r_a^2] = var f / (var f +
+// var e) = 1/2, exactly, since the plane fit acts on f and e alike.
+TEST(ErrorStructure, TemporalCorrelationIsTheFixedShareOfTheResidualVariance) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 0.002);
+  std::vector<float> a(kWidth * kHeight), b(kWidth * kHeight), c(kWidth * kHeight);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      const double plane = 1.2 + 0.0003 * u + 0.0002 * v, fixed = normal(rng);
+      a[v * kWidth + u] = static_cast<float>(plane + fixed + normal(rng));
+      b[v * kWidth + u] = static_cast<float>(plane + fixed + normal(rng));
+      c[v * kWidth + u] = static_cast<float>(plane + normal(rng));
+    }
+  }
+  const TemporalCorrelation same = AnalyseTemporalCorrelation(a, a, kWidth, kHeight, {});
+  EXPECT_DOUBLE_EQ(same.rho, 1.0);
+  const int windows = (kWidth / 9) * (kHeight / 9);
+  EXPECT_EQ(same.patches, windows);
+  const TemporalCorrelation half = AnalyseTemporalCorrelation(a, b, kWidth, kHeight, {});
+  EXPECT_NEAR(half.rho, 0.5, 0.03);
+  const TemporalCorrelation none = AnalyseTemporalCorrelation(a, c, kWidth, kHeight, {});
+  EXPECT_NEAR(none.rho, 0.0, 0.03);
+  // A window with a missing pixel in either frame is left out.
+  b[5 * kWidth + 5] = 0.0f;
+  EXPECT_EQ(AnalyseTemporalCorrelation(a, b, kWidth, kHeight, {}).patches, windows - 1);
+  EXPECT_THROW(AnalyseTemporalCorrelation(a, std::vector<float>(10), kWidth, kHeight, {}),
+               InputError);
+}
+
 TEST(ErrorStructure, BadInputNamesTheField) {
   ErrorStructureOptions options;
   options.patch_size = 8;
