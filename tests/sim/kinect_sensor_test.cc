@@ -14,6 +14,8 @@
 #include <numeric>
 
 #include "core/error.h"
+#include "sim/internal/avx2_kernels.h"
+#include "sim/internal/avx512_kernels.h"
 #include "tests/test_meshes.h"
 
 namespace mmh::sim {
@@ -460,6 +462,15 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
     EXPECT_EQ(x.depth, y.depth) << "vector kernels in use: " << vector;
     EXPECT_EQ(x.rgb, y.rgb);
     EXPECT_GT(std::count(x.depth.begin(), x.depth.end(), 0), 100);
+    // On an AVX-512 machine the AVX2 kernels too (elsewhere they were the vector kernels above).
+    if (internal::UseAvx512Default() && internal::UseAvx2Default()) {
+      KinectSensor avx2_sensor(options, &scene, Rigid3::Identity());
+      internal::UseAvx512().store(false);
+      const RgbdFrame z = avx2_sensor.Render(4);
+      KinectSensor::SetVectorKernels(true);
+      EXPECT_EQ(z.depth, y.depth) << "AVX2 kernels";
+      EXPECT_EQ(z.rgb, y.rgb) << "AVX2 kernels";
+    }
   }
 }
 
