@@ -1,5 +1,7 @@
 #include "sim/internal/avx2_kernels.h"
 
+#include <limits>
+
 #include "sim/internal/counter_random.h"
 
 #if MMH_SENSOR_AVX2
@@ -280,6 +282,110 @@ template MMH_AVX2 void DepthRowAvx2<false>(const DepthParams&, const float*, con
                                            const float*, const float*, const float*,
                                            const uint8_t*, const uint32_t*, const float*, int,
                                            uint8_t*, uint64_t*, uint16_t*);
+
+namespace {
+// Pixel k of ScoreSegmentAvx2 on its own (the last pixels of a segment), with the scalar
+// operations of ScoreAndTakeBest and TakeSecond.
+void ScorePixel(const int32_t* cross, const int32_t* sum_a, const double* inverse_a,
+                const int32_t* sum_b, const double* inverse_b, double count, int lo, int hi,
+                const int* first, const int* last, int k, int stride, double* scores,
+                double* best, int* best_d, double* left, double* right, double* second) {
+  double top = -std::numeric_limits<double>::infinity(), previous = 0.0;
+  int top_d = -1;
+  for (int d = lo; d <= hi; ++d) {
+    const size_t at = static_cast<size_t>(d - lo) * stride + k;
+    const int b = k - (d - lo);
+    const double numerator = count * static_cast<double>(cross[at]) -
+                             static_cast<double>(sum_a[k]) * static_cast<double>(sum_b[b]);
+    const double x = numerator * inverse_a[k] * inverse_b[b];
+    scores[at] = x;
+    right[k] = d == top_d + 1 ? x : right[k];
+    const bool better = (d >= first[k]) & (d <= last[k]) & (x > top);
+    top = better ? x : top;
+    top_d = better ? d : top_d;
+    left[k] = better ? previous : left[k];
+    previous = x;
+  }
+  double runner_up = -1.0;
+  for (int d = lo; d <= hi; ++d) {
+    const double x = scores[static_cast<size_t>(d - lo) * stride + k];
+    const int distance = d - top_d;
+    const bool take =
+        (d >= first[k]) & (d <= last[k]) & ((distance >= 2) | (distance <= -2)) & (x > runner_up);
+    runner_up = take ? x : runner_up;
+  }
+  best[k] = top;
+  best_d[k] = top_d;
+  second[k] = runner_up;
+}
+// Four 32-bit integers as doubles (exact).
+MMH_AVX2 inline __m256d Load4(const int32_t* x) {
+  return _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(x)));
+}
+}  // namespace
+
+// Four pixels at a time in double lanes; disparities, search bounds and the best d as doubles
+// (whole numbers, exact), so that every comparison is one vcmppd.
+MMH_AVX2 void ScoreSegmentAvx2(const int32_t* cross, const int32_t* sum_a, const double* inverse_a,
+                               const int32_t* sum_b, const double* inverse_b, double count, int lo,
+                               int hi, const int* first, const int* last, int n, int stride,
+                               double* scores, double* best, int* best_d, double* left,
+                               double* right, double* second) {
+  const __m256d count4 = _mm256_set1_pd(count), one = _mm256_set1_pd(1.0),
+                two = _mm256_set1_pd(2.0), minus_two = _mm256_set1_pd(-2.0),
+                minus_infinity = _mm256_set1_pd(-std::numeric_limits<double>::infinity());
+  int k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const __m256d a = Load4(sum_a + k), inverse = _mm256_loadu_pd(inverse_a + k);
+    const __m256d from = Load4(first + k), to = Load4(last + k);
+    __m256d top = minus_infinity;
+    __m256d top_d = _mm256_set1_pd(-1.0), previous = _mm256_setzero_pd();
+    __m256d beside_left = _mm256_loadu_pd(left + k), beside_right = _mm256_loadu_pd(right + k);
+    for (int d = lo; d <= hi; ++d) {
+      const size_t at = static_cast<size_t>(d - lo) * stride + k;
+      const int b = k - (d - lo);
+      const __m256d numerator =
+          _mm256_sub_pd(_mm256_mul_pd(count4, Load4(cross + at)), _mm256_mul_pd(a, Load4(sum_b + b)));
+      const __m256d x =
+          _mm256_mul_pd(_mm256_mul_pd(numerator, inverse), _mm256_loadu_pd(inverse_b + b));
+      _mm256_storeu_pd(scores + at, x);
+      const __m256d dd = _mm256_set1_pd(static_cast<double>(d));
+      beside_right = _mm256_blendv_pd(beside_right, x,
+                                      _mm256_cmp_pd(dd, _mm256_add_pd(top_d, one), _CMP_EQ_OQ));
+      // better ? x : top as max(candidate, top), candidate = x inside the search and -inf
+      // outside (vmaxpd(a, b) is a > b ? a : b): one operation on the chain from d to d + 1.
+      const __m256d candidate = _mm256_blendv_pd(
+          minus_infinity, x,
+          _mm256_and_pd(_mm256_cmp_pd(dd, from, _CMP_GE_OQ), _mm256_cmp_pd(dd, to, _CMP_LE_OQ)));
+      const __m256d better = _mm256_cmp_pd(candidate, top, _CMP_GT_OQ);
+      top = _mm256_max_pd(candidate, top);
+      top_d = _mm256_blendv_pd(top_d, dd, better);
+      beside_left = _mm256_blendv_pd(beside_left, previous, better);
+      previous = x;
+    }
+    __m256d runner_up = _mm256_set1_pd(-1.0);
+    for (int d = lo; d <= hi; ++d) {
+      const __m256d x = _mm256_loadu_pd(scores + static_cast<size_t>(d - lo) * stride + k);
+      const __m256d dd = _mm256_set1_pd(static_cast<double>(d));
+      const __m256d distance = _mm256_sub_pd(dd, top_d);
+      const __m256d far = _mm256_or_pd(_mm256_cmp_pd(distance, two, _CMP_GE_OQ),
+                                       _mm256_cmp_pd(distance, minus_two, _CMP_LE_OQ));
+      const __m256d take = _mm256_and_pd(
+          _mm256_and_pd(_mm256_cmp_pd(dd, from, _CMP_GE_OQ), _mm256_cmp_pd(dd, to, _CMP_LE_OQ)),
+          _mm256_and_pd(far, _mm256_cmp_pd(x, runner_up, _CMP_GT_OQ)));
+      runner_up = _mm256_blendv_pd(runner_up, x, take);
+    }
+    _mm256_storeu_pd(best + k, top);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(best_d + k), _mm256_cvttpd_epi32(top_d));
+    _mm256_storeu_pd(left + k, beside_left);
+    _mm256_storeu_pd(right + k, beside_right);
+    _mm256_storeu_pd(second + k, runner_up);
+  }
+  for (; k < n; ++k) {
+    ScorePixel(cross, sum_a, inverse_a, sum_b, inverse_b, count, lo, hi, first, last, k, stride,
+               scores, best, best_d, left, right, second);
+  }
+}
 
 // NoisyColor of 8 bytes at a time: slot j of value v stands for the byte v - 2^(slot_bits - 1) +
 // j with probability threshold / 2^kColorThresholdBits, otherwise for its alias. The entries are

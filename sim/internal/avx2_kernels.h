@@ -39,6 +39,16 @@ MMH_AVX2 void DepthRowAvx2(const DepthParams& q, const float* up, const float* r
                            const float* down, const float* depth, const float* cos_incidence,
                            const uint8_t* occluded, const uint32_t* drop_bits, const float* normal,
                            int n, uint8_t* edge, uint64_t* edge_bits, uint16_t* out);
+// The structured-light matcher's scoring of one row of a segment (speckle_matcher.cc,
+// ScoreAndTakeBest then TakeSecond for each d in [lo, hi]), with each pixel's best score, its
+// neighbours and the second best kept in registers over all disparities: cross and scores at
+// (d - lo) stride + k (k < n <= stride), sum_b and inverse_b of pixel k at d at [k - (d - lo)];
+// best, best_d, second are set, left and right keep their values where no score is better.
+MMH_AVX2 void ScoreSegmentAvx2(const int32_t* cross, const int32_t* sum_a, const double* inverse_a,
+                               const int32_t* sum_b, const double* inverse_b, double count, int lo,
+                               int hi, const int* first, const int* last, int n, int stride,
+                               double* scores, double* best, int* best_d, double* left,
+                               double* right, double* second);
 // ColorRowPortable, the table entries gathered 8 at a time.
 MMH_AVX2 void ColorRowAvx2(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
                            uint8_t* out);

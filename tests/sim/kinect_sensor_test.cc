@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <tuple>
 
 #include "core/error.h"
 #include "sim/internal/avx2_kernels.h"
@@ -444,10 +445,14 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
                           Eigen::Vector3d(0.03, -0.02, 0.8)));
   scene.Commit();
   // Colour noise of 1.5 (default), 2.5 and 12: tables of 32, 64 and 512 slots per value (looked
-  // up by one or two permutes, or gathered).
-  for (const auto& [quantise, read_noise] :
-       {std::pair{true, 1.5}, std::pair{false, 2.5}, std::pair{true, 12.0}}) {
+  // up by one or two permutes, or gathered); the structured-light mode (IR noise, matcher).
+  for (const auto& [quantise, read_noise, mode] :
+       {std::tuple{true, 1.5, SensorMode::kStatistical},
+        std::tuple{false, 2.5, SensorMode::kStatistical},
+        std::tuple{true, 12.0, SensorMode::kStatistical},
+        std::tuple{true, 1.5, SensorMode::kStructuredLight}}) {
     KinectSensorOptions options;
+    options.mode = mode;
     options.quantise = quantise;
     options.color.read_noise = read_noise;
     options.intrinsics.width = 333;  // rows that do not fill whole vectors
