@@ -152,11 +152,24 @@ MMH_SIMD_CLONES void WidenRows(const uint16_t* __restrict ir, int width, int row
   }
 }
 
+// BoxSums of the default 9-pixel window: each output summed directly (9 loads from L1, no
+// intermediate passes through memory; integer sums, so the same values).
+MMH_SIMD_CLONES void BoxSums9(const int32_t* __restrict in, int n, int32_t* __restrict out) {
+  for (int k = 0; k < n; ++k) {
+    out[k] = in[k] + in[k + 1] + in[k + 2] + in[k + 3] + in[k + 4] + in[k + 5] + in[k + 6] +
+             in[k + 7] + in[k + 8];
+  }
+}
+
 // out[k] = sum_{i < window} in[k + i] (exact), by doubling: sums of 1, 2, 4, ... consecutive
 // values, those of window's binary digits added up (5 passes for 9 instead of 9); a and b:
 // scratch of n + window.
 MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n, int32_t* __restrict a,
                              int32_t* __restrict b, int32_t* __restrict out) {
+  if (window == 9) {
+    BoxSums9(in, n, out);
+    return;
+  }
   const int total = n + window - 1;
   const int32_t* sums = in;  // sums of `width` consecutive values, valid for k < total - width + 1
   int32_t* next = a;
