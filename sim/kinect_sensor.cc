@@ -18,6 +18,7 @@
 #include <span>
 
 #include "core/error.h"
+#include "sim/internal/avx2_kernels.h"
 #include "sim/internal/avx512_kernels.h"
 #include "sim/internal/color_noise.h"
 #include "sim/internal/counter_random.h"
@@ -862,9 +863,10 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
 KinectSensor::~KinectSensor() = default;
 
 bool KinectSensor::SetVectorKernels(bool enabled) {
-  const bool available = UseAvx512Default();
-  UseAvx512().store(enabled && available);
-  return enabled && available;
+  const bool avx512 = UseAvx512Default(), avx2 = internal::UseAvx2Default();
+  UseAvx512().store(enabled && avx512);
+  internal::UseAvx2().store(enabled && avx2);
+  return enabled && (avx512 || avx2);
 }
 
 void KinectSensor::Render(int index, RenderMode mode, RgbdFrame* frame) {

@@ -198,9 +198,10 @@ class KinectSensor {
   void KeepMissingCauses(bool keep);
   std::span<const MissingCause> missing_causes() const;
 
-  // The per-pixel noise runs in hand-written AVX-512 kernels where the CPU has them, otherwise in
-  // portable ones; both give the same bytes. For tests and benchmarks: false selects the portable
-  // kernels for every sensor of the process; returns whether the vector kernels are now in use.
+  // The per-pixel noise runs in hand-written AVX-512 kernels where the CPU has them, else in AVX2
+  // ones where it has those, otherwise in portable ones; all give the same bytes. For tests and
+  // benchmarks: false selects the portable kernels for every sensor of the process; returns
+  // whether vector kernels are now in use.
   static bool SetVectorKernels(bool enabled);
 
  private:

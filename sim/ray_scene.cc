@@ -130,6 +130,8 @@ struct RayScene::Impl {
   };
 
   RTCDevice device = nullptr;
+  // Embree has no native 16-ray kernels on this CPU (no AVX-512) but 8-ray ones (TileCast).
+  bool split_packets = false;
   RTCScene static_scene = nullptr;  // static meshes in world coordinates
   RTCScene full_scene = nullptr;    // static instance + moving instances
   RTCScene moving_scene = nullptr;  // moving instances only
@@ -230,6 +232,9 @@ RayScene::RayScene() : impl_(std::make_unique<Impl>()) {
                              ErrorName(rtcGetDeviceError(nullptr)));
   }
   rtcSetDeviceErrorFunction(impl_->device, &Impl::OnError, impl_.get());
+  impl_->split_packets =
+      rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) == 0 &&
+      rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
   impl_->static_scene = impl_->NewScene();
   impl_->full_scene = impl_->NewScene();
   impl_->moving_scene = impl_->NewScene();
@@ -497,7 +502,55 @@ struct TileCast {
   const uint8_t* object_moving = nullptr;
   const Eigen::Matrix3f* world_R_object = nullptr;
   HitSink* sink = nullptr;
+  // Cast each 16-ray packet as two 8-ray ones (RayScene::Impl::split_packets).
+  bool split_packets = false;
 };
+
+// rtcIntersect16 without native 16-ray kernels: Embree's stream filter gathers the packet into
+// two 8-ray packets (rays 0-7 and 8-15), every lane whose tnear <= tfar valid (all of ours: the
+// lanes outside the tile's mask are traced too, their hits ignored), traces them with its 8-ray
+// kernel and scatters the hits back. This does the same with plain copies instead of gathers
+// and scatters: the same kernel on the same rays, so the same hits.
+void IntersectAsTwoPackets(RTCScene scene, RTCIntersectContext* context, RTCRayHit16* packet) {
+  alignas(32) static constexpr int kAll[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+  alignas(32) RTCRayHit8 half;
+  for (int h = 0; h < 2; ++h) {
+    const int o = 8 * h;
+    RTCRay16& r = packet->ray;
+    std::copy_n(r.org_x + o, 8, half.ray.org_x);
+    std::copy_n(r.org_y + o, 8, half.ray.org_y);
+    std::copy_n(r.org_z + o, 8, half.ray.org_z);
+    std::copy_n(r.tnear + o, 8, half.ray.tnear);
+    std::copy_n(r.dir_x + o, 8, half.ray.dir_x);
+    std::copy_n(r.dir_y + o, 8, half.ray.dir_y);
+    std::copy_n(r.dir_z + o, 8, half.ray.dir_z);
+    std::copy_n(r.time + o, 8, half.ray.time);
+    std::copy_n(r.tfar + o, 8, half.ray.tfar);
+    std::copy_n(r.mask + o, 8, half.ray.mask);
+    std::copy_n(r.id + o, 8, half.ray.id);
+    std::copy_n(r.flags + o, 8, half.ray.flags);
+    RTCHit16& hit = packet->hit;
+    // (Lanes without a hit keep all their hit fields, as with the stream filter.)
+    std::copy_n(hit.Ng_x + o, 8, half.hit.Ng_x);
+    std::copy_n(hit.Ng_y + o, 8, half.hit.Ng_y);
+    std::copy_n(hit.Ng_z + o, 8, half.hit.Ng_z);
+    std::copy_n(hit.u + o, 8, half.hit.u);
+    std::copy_n(hit.v + o, 8, half.hit.v);
+    std::copy_n(hit.primID + o, 8, half.hit.primID);
+    std::copy_n(hit.geomID + o, 8, half.hit.geomID);
+    std::copy_n(hit.instID[0] + o, 8, half.hit.instID[0]);
+    rtcIntersect8(kAll, scene, context, &half);
+    std::copy_n(half.ray.tfar, 8, r.tfar + o);
+    std::copy_n(half.hit.Ng_x, 8, hit.Ng_x + o);
+    std::copy_n(half.hit.Ng_y, 8, hit.Ng_y + o);
+    std::copy_n(half.hit.Ng_z, 8, hit.Ng_z + o);
+    std::copy_n(half.hit.u, 8, hit.u + o);
+    std::copy_n(half.hit.v, 8, hit.v + o);
+    std::copy_n(half.hit.primID, 8, hit.primID + o);
+    std::copy_n(half.hit.geomID, 8, hit.geomID + o);
+    std::copy_n(half.hit.instID[0], 8, hit.instID[0] + o);
+  }
+}
 
 // Casts tiles [first, last) of c.tiles and hands their packets to the sink; returns the number of
 // rays. Cloned per x86-64 level (MMH_SIMD_CLONES) with the lane loops it inlines, so that they
@@ -547,7 +600,11 @@ MMH_SIMD_CLONES uint64_t CastTiles(const TileCast& c, size_t first, size_t last)
       }
     }
     rays += std::popcount(static_cast<unsigned>(mask));
-    rtcIntersect16(valid, c.scene, &context, &packet);
+    if (c.split_packets) {
+      IntersectAsTwoPackets(c.scene, &context, &packet);
+    } else {
+      rtcIntersect16(valid, c.scene, &context, &packet);
+    }
     out.u0 = u0;
     out.v0 = v0;
     out.cast = mask;
@@ -678,6 +735,7 @@ void RayScene::Impl::CastRays(RTCScene scene, Lookup lookup, uint32_t fixed_obje
   }
   TileCast c;
   c.scene = scene;
+  c.split_packets = s.split_packets;
   c.kind = lookup == Lookup::kFixed ? TileCast::kFixed
            : instanced              ? TileCast::kInstanced
                                     : TileCast::kStatic;

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/simd.h"
+#include "sim/internal/avx2_kernels.h"
 #include "sim/internal/avx512_kernels.h"
 #include "sim/internal/counter_random.h"
 
@@ -117,6 +118,12 @@ void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, i
     } else {
       ColorRowAvx512<0>(p, in, first_counter, n, out);
     }
+    return;
+  }
+#endif
+#if MMH_SENSOR_AVX2
+  if (UseAvx2().load(std::memory_order_relaxed)) {
+    ColorRowAvx2(p, in, first_counter, n, out);
     return;
   }
 #endif

@@ -37,7 +37,7 @@ std::vector<uint32_t> ColorAliasTable(const ColorModel& color, int* slot_bits);
 // first_counter + i.
 void ColorRowPortable(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
                       uint8_t* out);
-// ColorRowPortable or its vector kernel (same bytes).
+// ColorRowPortable or its AVX-512 or AVX2 kernel where enabled (same bytes).
 void ColorRow(const ColorParams& p, const uint8_t* in, uint32_t first_counter, int n,
               uint8_t* out);
 

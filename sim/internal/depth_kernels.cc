@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "core/simd.h"
+#include "sim/internal/avx2_kernels.h"
 #include "sim/internal/avx512_kernels.h"
 #include "sim/internal/counter_random.h"
 #include "sim/ray_scene.h"
@@ -71,6 +72,12 @@ void DepthNoise(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* dro
     return;
   }
 #endif
+#if MMH_SENSOR_AVX2
+  if (UseAvx2().load(std::memory_order_relaxed)) {
+    DepthNoiseAvx2(q, first_pixel, n, drop_bits, normal);
+    return;
+  }
+#endif
   DepthNoisePortable(q, first_pixel, n, drop_bits, normal);
 }
 
@@ -85,6 +92,14 @@ void DepthRow(const DepthParams& q, const float* up, const float* row, const flo
     DepthNoiseAvx512(q, first_pixel, n, drop_bits, normal);
     DepthRowAvx512<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
                               n, edge, edge_bits, out);
+    return;
+  }
+#endif
+#if MMH_SENSOR_AVX2
+  if (UseAvx2().load(std::memory_order_relaxed)) {
+    DepthNoiseAvx2(q, first_pixel, n, drop_bits, normal);
+    DepthRowAvx2<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal, n,
+                            edge, edge_bits, out);
     return;
   }
 #endif

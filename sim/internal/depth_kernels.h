@@ -1,6 +1,6 @@
 // The per-pixel depth model of the synthetic Kinect (docs/sensor.md, "Depth", steps 3-7): axial
-// noise, disparity lattice, range and dropouts, row by row, in portable C++ or the AVX-512
-// kernels (avx512_kernels.h), which give the same bytes.
+// noise, disparity lattice, range and dropouts, row by row, in portable C++ or the AVX-512 or AVX2
+// kernels (avx512_kernels.h, avx2_kernels.h), which give the same bytes.
 #pragma once
 
 #include <cmath>
@@ -66,7 +66,8 @@ inline uint16_t DepthSample(const DepthParams& q, float z, float cos_incidence, 
 // key_b hash of k as their dropout uniforms.
 void DepthNoisePortable(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
                         float* normal);
-// DepthNoisePortable or its AVX-512 kernel where enabled (UseAvx512): the same numbers.
+// DepthNoisePortable or its AVX-512 or AVX2 kernel where enabled (UseAvx512, UseAvx2): the same
+// numbers.
 void DepthNoise(const DepthParams& q, uint32_t first_pixel, int n, uint32_t* drop_bits,
                 float* normal);
 
@@ -95,8 +96,8 @@ inline void PackEdgeBits(const uint8_t* edge, int first, int last, uint64_t* wor
 }
 
 // One depth row: its random numbers (drop_bits, normal: #n scratch), then the pixels, with the
-// edge flags as bits (edge_bits: #ceil(n / 64); edge: #n scratch). The vector kernels where
-// enabled (UseAvx512), the portable ones otherwise.
+// edge flags as bits (edge_bits: #ceil(n / 64); edge: #n scratch). The AVX-512 or AVX2 kernels
+// where enabled (UseAvx512, UseAvx2), the portable ones otherwise.
 template <bool kQuantise>
 void DepthRow(const DepthParams& q, const float* up, const float* row, const float* down,
               const float* depth, const float* cos_incidence, const uint8_t* occluded,

@@ -9,6 +9,8 @@
 #include <limits>
 
 #include "core/simd.h"
+#include "sim/internal/avx2_kernels.h"
+#include "sim/internal/avx512_kernels.h"
 #include "sim/internal/counter_random.h"
 #include "sim/internal/depth_kernels.h"
 
@@ -150,11 +152,24 @@ MMH_SIMD_CLONES void WidenRows(const uint16_t* __restrict ir, int width, int row
   }
 }
 
+// BoxSums of the default 9-pixel window: each output summed directly (9 loads from L1, no
+// intermediate passes through memory; integer sums, so the same values).
+MMH_SIMD_CLONES void BoxSums9(const int32_t* __restrict in, int n, int32_t* __restrict out) {
+  for (int k = 0; k < n; ++k) {
+    out[k] = in[k] + in[k + 1] + in[k + 2] + in[k + 3] + in[k + 4] + in[k + 5] + in[k + 6] +
+             in[k + 7] + in[k + 8];
+  }
+}
+
 // out[k] = sum_{i < window} in[k + i] (exact), by doubling: sums of 1, 2, 4, ... consecutive
 // values, those of window's binary digits added up (5 passes for 9 instead of 9); a and b:
 // scratch of n + window.
 MMH_SIMD_CLONES void BoxSums(const int32_t* __restrict in, int window, int n, int32_t* __restrict a,
                              int32_t* __restrict b, int32_t* __restrict out) {
+  if (window == 9) {
+    BoxSums9(in, n, out);
+    return;
+  }
   const int total = n + window - 1;
   const int32_t* sums = in;  // sums of `width` consecutive values, valid for k < total - width + 1
   int32_t* next = a;
@@ -365,7 +380,7 @@ struct SpeckleMatcher::BandScratch {
   std::vector<int32_t> box_a, box_b;  // BoxSums' scratch
   // Per segment:
   std::vector<int32_t> products;  // window column products, (d - lo) stride + k
-  std::vector<int32_t> cross;
+  std::vector<int32_t> cross;    // window sums of the products (AVX2: (d - row lo) kSegment + k)
   std::vector<double> scores;    // (d - lo) kSegment + k
   std::vector<int> code;         // the verdict (MissingCause) per pixel
   std::vector<float> disparity;  // the matched disparity per pixel
@@ -627,6 +642,7 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
     const int count = hi >= lo ? hi - lo + 1 : 0;
     s.products.resize(static_cast<size_t>(count) * length);
     s.scores.resize(static_cast<size_t>(count) * kSegment);
+    s.cross.resize(static_cast<size_t>(count) * kSegment);
     for (int v = v0; v < v1; ++v) {
       const size_t at = static_cast<size_t>(v - v0) * w;
       // The window's column products at every disparity: summed down the window for the
@@ -654,22 +670,40 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
       }
       const int* first = &s.first[at + start];
       const int* last = &s.last[at + start];
-      std::fill_n(s.best.begin(), span, -std::numeric_limits<double>::infinity());
-      std::fill_n(s.best_d.begin(), span, -1);
-      std::fill_n(s.second.begin(), span, -1.0);
-      for (int d = row_lo; d <= row_hi; ++d) {
-        BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.box_a.data(),
-                s.box_b.data(), s.cross.data());
-        const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - d - x_min_);
-        double* score = &s.scores[static_cast<size_t>(d - lo) * kSegment];
-        ScoreAndTakeBest(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
-                         &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, d, first,
-                         last, span, d > row_lo ? score - kSegment : s.none.data(), score,
-                         s.best.data(), s.best_d.data(), s.left.data(), s.right.data());
-      }
-      for (int d = row_lo; d <= row_hi; ++d) {
-        TakeSecond(&s.scores[static_cast<size_t>(d - lo) * kSegment], d, first, last,
-                   s.best_d.data(), span, s.second.data());
+#if MMH_SENSOR_AVX2
+      if (UseAvx2().load(std::memory_order_relaxed) &&
+          !UseAvx512().load(std::memory_order_relaxed)) {
+        // The same scores, every disparity's window sums first.
+        for (int d = row_lo; d <= row_hi; ++d) {
+          BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.box_a.data(),
+                  s.box_b.data(), &s.cross[static_cast<size_t>(d - row_lo) * kSegment]);
+        }
+        const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - row_lo - x_min_);
+        ScoreSegmentAvx2(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
+                         &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, row_lo,
+                         row_hi, first, last, span, kSegment,
+                         &s.scores[static_cast<size_t>(row_lo - lo) * kSegment], s.best.data(),
+                         s.best_d.data(), s.left.data(), s.right.data(), s.second.data());
+      } else  // NOLINT(readability/braces)
+#endif
+      {
+        std::fill_n(s.best.begin(), span, -std::numeric_limits<double>::infinity());
+        std::fill_n(s.best_d.begin(), span, -1);
+        std::fill_n(s.second.begin(), span, -1.0);
+        for (int d = row_lo; d <= row_hi; ++d) {
+          BoxSums(&s.products[static_cast<size_t>(d - lo) * length], window, span, s.box_a.data(),
+                  s.box_b.data(), s.cross.data());
+          const size_t stats_at = static_cast<size_t>(v) * columns_ + (start - d - x_min_);
+          double* score = &s.scores[static_cast<size_t>(d - lo) * kSegment];
+          ScoreAndTakeBest(s.cross.data(), &s.sum[at + start], &s.inverse_norm[at + start],
+                           &reference_sum_[stats_at], &reference_inverse_norm_[stats_at], n, d, first,
+                           last, span, d > row_lo ? score - kSegment : s.none.data(), score,
+                           s.best.data(), s.best_d.data(), s.left.data(), s.right.data());
+        }
+        for (int d = row_lo; d <= row_hi; ++d) {
+          TakeSecond(&s.scores[static_cast<size_t>(d - lo) * kSegment], d, first, last,
+                     s.best_d.data(), span, s.second.data());
+        }
       }
       Decide(s.best.data(), s.best_d.data(), s.second.data(), s.left.data(), s.right.data(), first,
              last, &s.pre[at + start], min_correlation, ambiguity, span, s.code.data(),

@@ -12,8 +12,11 @@
 #include <map>
 #include <memory>
 #include <numeric>
+#include <tuple>
 
 #include "core/error.h"
+#include "sim/internal/avx2_kernels.h"
+#include "sim/internal/avx512_kernels.h"
 #include "tests/test_meshes.h"
 
 namespace mmh::sim {
@@ -442,10 +445,14 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
                           Eigen::Vector3d(0.03, -0.02, 0.8)));
   scene.Commit();
   // Colour noise of 1.5 (default), 2.5 and 12: tables of 32, 64 and 512 slots per value (looked
-  // up by one or two permutes, or gathered).
-  for (const auto& [quantise, read_noise] :
-       {std::pair{true, 1.5}, std::pair{false, 2.5}, std::pair{true, 12.0}}) {
+  // up by one or two permutes, or gathered); the structured-light mode (IR noise, matcher).
+  for (const auto& [quantise, read_noise, mode] :
+       {std::tuple{true, 1.5, SensorMode::kStatistical},
+        std::tuple{false, 2.5, SensorMode::kStatistical},
+        std::tuple{true, 12.0, SensorMode::kStatistical},
+        std::tuple{true, 1.5, SensorMode::kStructuredLight}}) {
     KinectSensorOptions options;
+    options.mode = mode;
     options.quantise = quantise;
     options.color.read_noise = read_noise;
     options.intrinsics.width = 333;  // rows that do not fill whole vectors
@@ -460,6 +467,15 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
     EXPECT_EQ(x.depth, y.depth) << "vector kernels in use: " << vector;
     EXPECT_EQ(x.rgb, y.rgb);
     EXPECT_GT(std::count(x.depth.begin(), x.depth.end(), 0), 100);
+    // On an AVX-512 machine the AVX2 kernels too (elsewhere they were the vector kernels above).
+    if (internal::UseAvx512Default() && internal::UseAvx2Default()) {
+      KinectSensor avx2_sensor(options, &scene, Rigid3::Identity());
+      internal::UseAvx512().store(false);
+      const RgbdFrame z = avx2_sensor.Render(4);
+      KinectSensor::SetVectorKernels(true);
+      EXPECT_EQ(z.depth, y.depth) << "AVX2 kernels";
+      EXPECT_EQ(z.rgb, y.rgb) << "AVX2 kernels";
+    }
   }
 }
 
