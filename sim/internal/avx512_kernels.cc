@@ -226,9 +226,12 @@ MMH_AVX512 void DepthRowAvx512(const DepthParams& q, const float* up, const floa
     PackEdgeBits(edge, 0, n, edge_bits);
     return;
   }
-  // Pixel 0 (no left neighbour): the portable code.
+  // Pixel 0 (no left neighbour): the portable code, on pixels 0 and 1 so that pixel 0 compares
+  // with its right neighbour (pixel 1, taken there as the row's end, is the first block's).
+  // (Until 2026-11-28 on pixel 0 alone, as the row's end: its edge flag could differ from the
+  // portable kernel's, found by tests/sim/sensor_kernels_test.cc.)
   DepthRowPortable<kQuantise>(q, up, row, down, depth, cos_incidence, occluded, drop_bits, normal,
-                              0, 1, edge, out);
+                              0, 2, edge, out);
   PackEdgeBits(edge, 0, 1, edge_bits);
   int i = 1;
   for (; i + 16 < n; i += 16) {

@@ -44,9 +44,7 @@ std::vector<Kernels> VectorKernels() {
 #endif
 #if MMH_SENSOR_AVX512
   if (UseAvx512Default()) {
-    // (Its depth row computes pixel 0 as the row's end, without its right neighbour, so that
-    // pixel's edge flag can differ from the portable kernel's: not compared here.)
-    kernels.push_back({"AVX-512", DepthNoiseAvx512, nullptr, nullptr,
+    kernels.push_back({"AVX-512", DepthNoiseAvx512, DepthRowAvx512<true>, DepthRowAvx512<false>,
                        [](const ColorParams& p, const uint8_t* in, uint32_t first, int n,
                           uint8_t* out) {
                          if (p.slot_bits <= 5) {
@@ -127,7 +125,6 @@ TEST(DepthKernels, VectorNoiseEqualsThePortableNoise) {
 std::vector<std::pair<Kernels, bool>> Cases(const std::vector<Kernels>& kernels) {
   std::vector<std::pair<Kernels, bool>> cases;
   for (const Kernels& k : kernels) {
-    if (k.row_quantised == nullptr) continue;
     for (const bool quantise : {true, false}) cases.emplace_back(k, quantise);
   }
   return cases;
