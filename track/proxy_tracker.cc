@@ -243,8 +243,18 @@ std::vector<IcpResult> ProxyTracker::CoarseHypotheses(const IcpOptions& coarse_i
 struct ProxyTracker::DetectionRanking {
   std::optional<Rigid3> predicted;
   std::optional<Candidate> best;
+  // verified's index of best (nullopt while best is not verified, or after it is replaced).
+  std::optional<size_t> best_verified;
   std::vector<Rigid3> refined_poses;
   std::vector<Candidate> verified;
+  // verified[i]'s colour agreement, computed once (VerifiedAgreement): the appearance check and
+  // the rival's choice both ask for it, and each computation projects every face of the coloured
+  // model (16 384 for the gelatin box's scan) and averages a window of pixels at each.
+  struct Agreement {
+    bool computed = false;
+    std::optional<double> value;
+  };
+  std::vector<Agreement> agreements;
 };
 
 namespace {
@@ -314,7 +324,11 @@ bool ProxyTracker::Better(const Candidate& a, const std::optional<Candidate>& b,
 void ProxyTracker::Weigh(const RgbdFrame& frame, const IcpResult& refined,
                          DetectionRanking* ranking) const {
   Candidate candidate = Verify(frame, refined);
-  if (Better(candidate, ranking->best, ranking->predicted)) ranking->best = candidate;
+  if (Better(candidate, ranking->best, ranking->predicted)) {
+    ranking->best = candidate;
+    ranking->best_verified.reset();
+    if (candidate.good) ranking->best_verified = ranking->verified.size();
+  }
   if (candidate.good) ranking->verified.push_back(candidate);
 }
 
@@ -394,16 +408,19 @@ void ProxyTracker::WeighTwins(const RgbdFrame& frame, const IcpOptions& coarse_i
   }
 }
 
-void ProxyTracker::SetDetectionRival(const RgbdFrame& frame, const DetectionRanking& ranking) {
+void ProxyTracker::SetDetectionRival(const RgbdFrame& frame, DetectionRanking* ranking) {
   // The rival: the best-scoring verified pose more than 45 deg from the winner (a near-symmetric
   // twin that the data could not rule out), kept as the turn from the winner in the model's
   // frame (proxy_T_rival) and carried along with the track (Track: the twin evidence). A twin
   // whose colours agree min_gain worse than the winner's is ruled out (the appearance check).
-  const Rigid3 camera_T_best = ranking.best->icp.proxy_T_camera.Inverse();
+  // The winner was refined on all the frame's data after the ranking: its agreement is at the
+  // refined pose, the twins' are the ranking's.
+  const Rigid3 camera_T_best = ranking->best->icp.proxy_T_camera.Inverse();
   const std::optional<double> best_appearance = AppearanceAgreement(frame, camera_T_best);
   detection_rival_.reset();
   double rival_score = 0.0;
-  for (const Candidate& candidate : ranking.verified) {
+  for (size_t i = 0; i < ranking->verified.size(); ++i) {
+    const Candidate& candidate = ranking->verified[i];
     const Rigid3 camera_T_pose = candidate.icp.proxy_T_camera.Inverse();
     const double score = candidate.Score();
     if (RotationAngle(camera_T_pose.rotation, camera_T_best.rotation) <= std::numbers::pi / 4) {
@@ -411,7 +428,7 @@ void ProxyTracker::SetDetectionRival(const RgbdFrame& frame, const DetectionRank
     }
     if (detection_rival_ && score <= rival_score) continue;
     if (best_appearance) {
-      const std::optional<double> appearance = AppearanceAgreement(frame, camera_T_pose);
+      const std::optional<double> appearance = VerifiedAgreement(frame, i, ranking);
       if (appearance && *appearance < *best_appearance - options_.appearance.min_gain) continue;
     }
     detection_rival_ = camera_T_best.Inverse() * camera_T_pose;
@@ -459,7 +476,8 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
     ranking.best = Verify(
         frame, AlignPointToPlane(*model_, data_, scored_, options_.verification.skin_distance,
                                  ranking.best->icp.proxy_T_camera, search_icp_, sample_matches_));
-    SetDetectionRival(frame, ranking);
+    ranking.best_verified.reset();  // refined: no longer the verified pose
+    SetDetectionRival(frame, &ranking);
   }
   return ranking.best;
 }
@@ -543,9 +561,7 @@ ProxyTracker::PoseScore ProxyTracker::ScorePose(const RgbdFrame& frame,
   score.explained = candidate.explained;
   score.score = candidate.Score();
   score.good = candidate.good;
-  if (appearance_) {
-    score.appearance = appearance_->Agreement(frame, score.camera_T_proxy, options_.appearance);
-  }
+  score.appearance = AppearanceAgreement(frame, score.camera_T_proxy);
   return score;
 }
 
@@ -559,26 +575,39 @@ std::optional<double> ProxyTracker::AppearanceAgreement(const RgbdFrame& frame,
   return appearance_->Agreement(frame, camera_T_proxy, options_.appearance);
 }
 
+std::optional<double> ProxyTracker::VerifiedAgreement(const RgbdFrame& frame, size_t i,
+                                                      DetectionRanking* ranking) const {
+  ranking->agreements.resize(ranking->verified.size());
+  DetectionRanking::Agreement& agreement = ranking->agreements[i];
+  if (!agreement.computed) {
+    agreement.value = AppearanceAgreement(frame, ranking->verified[i].icp.proxy_T_camera.Inverse());
+    agreement.computed = true;
+  }
+  return agreement.value;
+}
+
 void ProxyTracker::ChooseByAppearance(const RgbdFrame& frame, DetectionRanking* ranking) const {
   // The depth's winner stands unless a verified pose the depth scores as well (within margin)
   // shows the model's colours where the image has them, min_gain better than the winner does.
+  // A verified winner is one of ranking->verified (Weigh).
   if (!ranking->best->good) return;
-  const std::optional<double> best =
-      AppearanceAgreement(frame, ranking->best->icp.proxy_T_camera.Inverse());
+  const std::optional<double> best = VerifiedAgreement(frame, *ranking->best_verified, ranking);
   if (!best) return;
   const double best_score = ranking->best->Score();
   double chosen_agreement = *best + options_.appearance.min_gain;
-  const Candidate* chosen = nullptr;
-  for (const Candidate& candidate : ranking->verified) {
-    if (candidate.Score() < best_score - options_.appearance.margin) continue;
-    const std::optional<double> agreement =
-        AppearanceAgreement(frame, candidate.icp.proxy_T_camera.Inverse());
+  std::optional<size_t> chosen;
+  for (size_t i = 0; i < ranking->verified.size(); ++i) {
+    if (ranking->verified[i].Score() < best_score - options_.appearance.margin) continue;
+    const std::optional<double> agreement = VerifiedAgreement(frame, i, ranking);
     if (agreement && *agreement > chosen_agreement) {
       chosen_agreement = *agreement;
-      chosen = &candidate;
+      chosen = i;
     }
   }
-  if (chosen) ranking->best = *chosen;
+  if (chosen) {
+    ranking->best = ranking->verified[*chosen];
+    ranking->best_verified = chosen;
+  }
 }
 
 size_t ProxyTracker::PrepareMediumData() {

@@ -299,8 +299,9 @@ class ProxyTracker {
     Rigid3 camera_T_proxy;
     double inlier_share = 0.0, rms = 0.0, free_space_violation = 0.0, explained = 0.0, score = 0.0;
     bool good = false;
-    // The appearance model's agreement with the colour image at the refined pose (nullopt without
-    // a model or with too few samples seen).
+    // The appearance model's agreement with the colour image at the refined pose, as the
+    // detection computes it (nullopt when the check is off: no model or appearance.margin 0; or
+    // with too few samples seen).
     std::optional<double> appearance;
   };
   PoseScore ScorePose(const RgbdFrame& frame, const Rigid3& camera_T_proxy) const;
@@ -382,13 +383,16 @@ class ProxyTracker {
   std::vector<Rigid3> MotionSeeds(const std::optional<Rigid3>& predicted) const;
   void WeighTwins(const RgbdFrame& frame, const IcpOptions& coarse_icp, size_t medium_scored,
                   DetectionRanking* ranking) const;
-  void SetDetectionRival(const RgbdFrame& frame, const DetectionRanking& ranking);
+  void SetDetectionRival(const RgbdFrame& frame, DetectionRanking* ranking);
   // The appearance check (AppearanceOptions): among ranking's verified poses within margin of the
   // best's score, the one whose colours agree best replaces the best when it agrees min_gain
-  // better. A pose's agreement, when the check is on (nullopt otherwise, or too few samples).
+  // better. A pose's agreement, when the check is on (the one gate: a model and margin > 0;
+  // nullopt otherwise, or too few samples); verified[i]'s, computed once per detection.
   void ChooseByAppearance(const RgbdFrame& frame, DetectionRanking* ranking) const;
   std::optional<double> AppearanceAgreement(const RgbdFrame& frame,
                                             const Rigid3& camera_T_proxy) const;
+  std::optional<double> VerifiedAgreement(const RgbdFrame& frame, size_t i,
+                                          DetectionRanking* ranking) const;
   // The detection among the model-sized segments (DetectionOptions::model_segments); leaves
   // segmentation_ and data_ holding the winner's segment.
   std::optional<Candidate> DetectAmongSegments(const RgbdFrame& frame,

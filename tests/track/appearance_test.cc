@@ -89,8 +89,11 @@ TEST(AppearanceModelTest, TellsAHalfTurnThatDepthCannotSee) {
   const std::optional<double> right = model.Agreement(frame, truth, options);
   const std::optional<double> wrong = model.Agreement(frame, turned, options);
   ASSERT_TRUE(right && wrong);
-  EXPECT_GT(*right, 0.95);
-  EXPECT_LT(*wrong, -0.9);
+  // Measured 0.9917 and -0.9917 (2026-11-28; the gain and offset per channel keep the
+  // chromaticities from matching exactly): pure arithmetic on a synthetic frame, so the bounds
+  // allow 0.01 for other compilers only.
+  EXPECT_GT(*right, 0.98);
+  EXPECT_LT(*wrong, -0.98);
   // Seen from behind (turned over about x: the plate faces away), nothing is seen.
   const Rigid3 back(Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX())),
                     Eigen::Vector3d(0, 0, 0.5));

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <sstream>
+#include <tuple>
 #include <vector>
 #include <nlohmann/json.hpp>
 
@@ -31,6 +32,23 @@ const std::string kPreset = std::string(MMH_SOURCE_DIR) + "/configs/track_real.j
 struct Scores {
   double median_rotation_deg, median_translation_mm, recall_5deg_5cm, ar;
 };
+
+// The bounds are the figures measured on 2026-11-28 at 9f2f81e (docs/tracker.md, "The sim-to-real
+// gap", the same commands) with a margin in the worse direction only: a run is deterministic (the
+// same input gives the same trajectory), so the margin covers other compilers and library
+// versions and small intended changes, not noise: 0.5 deg of median rotation and 0.5 mm of median
+// translation (a quarter of the issue's 2 deg goal; the largest shift any of the preset's
+// options made to another object's medians was 0.13 deg / 0.04 mm), one frame of ten in the
+// recall within 5 deg / 5 cm, and 0.02 of BOP's AR (a fifth of one frame's AR at 10 frames).
+constexpr double kRotationMarginDeg = 0.5, kTranslationMarginMm = 0.5, kRecallMargin = 0.1,
+                 kArMargin = 0.02;
+
+void ExpectNoWorseThan(const Scores& got, const Scores& measured) {
+  EXPECT_LT(got.median_rotation_deg, measured.median_rotation_deg + kRotationMarginDeg);
+  EXPECT_LT(got.median_translation_mm, measured.median_translation_mm + kTranslationMarginMm);
+  EXPECT_GE(got.recall_5deg_5cm, measured.recall_5deg_5cm - kRecallMargin);
+  EXPECT_GE(got.ar, measured.ar - kArMargin);
+}
 
 // `model` under tests/data/real/ycbv (models/: the fitted cuboids; models_real/: the hulls of the
 // dataset's own model points), `video` a folder of it, `extra` more flags for `mmh track`.
@@ -61,38 +79,29 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
 
 TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromTheTruthsFirstPose) {
   TempDir dir;
-  for (const auto& [object, model] :
-       {std::pair<int, std::string>{8, "models/009_gelatin_box.obj"},
-        {21, "models/061_foam_brick.obj"}}) {
+  // Measured (median rotation deg, translation mm, recall within 5 deg / 5 cm, AR): the box
+  // 1.209, 1.706, 1.0, 1.000; the brick 2.470, 1.967, 1.0, 0.978.
+  for (const auto& [object, model, measured] :
+       {std::tuple<int, std::string, Scores>{8, "models/009_gelatin_box.obj", {1.209, 1.706, 1.0, 1.0}},
+        {21, "models/061_foam_brick.obj", {2.470, 1.967, 1.0, 0.978}}}) {
     SCOPED_TRACE(model);
-    const Scores truth = TrackAndEval(dir, object, model, "truth");
-    // Measured 1.13 deg / 1.71 mm (box) and 2.52 deg / 1.97 mm (brick), all 10 frames within
-    // 5 deg / 5 cm, AR 1.0 and 0.974 (docs/tracker.md, "Real recordings"); bounds with margin.
-    EXPECT_LT(truth.median_rotation_deg, 4.0);
-    EXPECT_LT(truth.median_translation_mm, 4.0);
-    EXPECT_GE(truth.recall_5deg_5cm, 0.9);
-    EXPECT_GE(truth.ar, 0.9);
+    ExpectNoWorseThan(TrackAndEval(dir, object, model, "truth"), measured);
   }
 }
 
 TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
   TempDir dir;
   // The detection among the model-sized segments (configs/track_real.json). Measured: gelatin box
-  // 1.25 deg / 1.73 mm, brick 2.37 deg / 1.59 mm (errors against the nearest symmetric truth,
+  // 1.247 deg / 1.730 mm, brick 2.374 deg / 1.593 mm (errors against the nearest symmetric truth,
   // models/models_info.json: the detection picks a half turn of the brick's square prism), all 10
-  // frames within 5 deg / 5 cm, AR 1.0 and 0.979 (docs/tracker.md). The issue's goals: median
-  // <= 2 deg, <= 5 mm, >= 90 % within 5 deg / 5 cm; the brick's rotation misses the 2 deg by the
-  // cuboid model's bias (2.47 deg from the truth's first pose too).
+  // frames within 5 deg / 5 cm, AR 1.000 and 0.979. The box meets the issue's goals (median
+  // <= 2 deg, <= 5 mm, >= 90 % within 5 deg / 5 cm, and its bound is inside them); the brick
+  // misses the 2 deg, where the truth and the depth disagree (2.47 deg from the truth's first
+  // pose, 2.46 with the real shape: docs/tracker.md).
   const Scores box = TrackAndEval(dir, 8, "models/009_gelatin_box.obj", "detection");
-  EXPECT_LT(box.median_rotation_deg, 2.0);
-  EXPECT_LT(box.median_translation_mm, 5.0);
-  EXPECT_GE(box.recall_5deg_5cm, 0.9);
-  EXPECT_GE(box.ar, 0.9);
+  ExpectNoWorseThan(box, {1.247, 1.730, 1.0, 1.0});
   const Scores brick = TrackAndEval(dir, 21, "models/061_foam_brick.obj", "detection");
-  EXPECT_LT(brick.median_rotation_deg, 3.5);
-  EXPECT_LT(brick.median_translation_mm, 5.0);
-  EXPECT_GE(brick.recall_5deg_5cm, 0.9);
-  EXPECT_GE(brick.ar, 0.9);
+  ExpectNoWorseThan(brick, {2.374, 1.593, 1.0, 0.979});
 
   // Both objects in one call from the runs' BOP result files: the same per-object figures (R to
   // 9 digits), and the pooled row weighs them by frames.
@@ -125,25 +134,22 @@ TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
 }
 
 // The hulls of the dataset's own model points (models_real/, PROVENANCE.md) instead of the fitted
-// cuboids, from the truth's first pose. Measured: gelatin box 1.54 deg / 0.89 mm, AR 1.0; foam
-// brick 2.46 deg / 1.41 mm, AR 0.990 (the cuboid: 2.47 deg / 1.97 mm, AR 0.978): the brick's
-// 2.5 deg stays with the real shape (docs/tracker.md, "The sim-to-real gap").
+// cuboids, from the truth's first pose. Measured: gelatin box 1.538 deg / 0.891 mm, all 10
+// frames within 5 deg / 5 cm, AR 1.000; foam brick 2.465 deg / 1.413 mm, 10 of 10, AR 0.990 (the
+// cuboid: 2.47 deg / 1.97 mm, AR 0.978): the brick's 2.5 deg stays with the real shape
+// (docs/tracker.md, "The sim-to-real gap").
 TEST(RealRecordingCliTest, TracksYcbVideoObjectsWithTheirRealModelPoints) {
   TempDir dir;
-  const Scores box = TrackAndEval(dir, 8, "models_real/009_gelatin_box.obj", "truth");
-  EXPECT_LT(box.median_rotation_deg, 2.5);
-  EXPECT_LT(box.median_translation_mm, 2.5);
-  EXPECT_GE(box.ar, 0.95);
-  const Scores brick = TrackAndEval(dir, 21, "models_real/061_foam_brick.obj", "truth");
-  EXPECT_LT(brick.median_rotation_deg, 3.5);
-  EXPECT_LT(brick.median_translation_mm, 2.5);
-  EXPECT_GE(brick.recall_5deg_5cm, 0.9);
-  EXPECT_GE(brick.ar, 0.95);
+  ExpectNoWorseThan(TrackAndEval(dir, 8, "models_real/009_gelatin_box.obj", "truth"),
+                    {1.538, 0.891, 1.0, 1.0});
+  ExpectNoWorseThan(TrackAndEval(dir, 21, "models_real/061_foam_brick.obj", "truth"),
+                    {2.465, 1.413, 1.0, 0.990});
 }
 
 // A can (a cylinder: continuous symmetry about its axis, models_real/models_info.json) found by
 // the tracker's own detection on a real frame among a sugar box, a meat can and a pitcher.
-// Measured 1.84 deg / 2.40 mm, AR 0.967. The table check is widened to 2 cm: on this frame the
+// Measured 1.844 deg / 2.398 mm, within 5 deg / 5 cm, AR 0.967 (one frame: the recall margin
+// leaves none). The table check is widened to 2 cm: on this frame the
 // dataset's own truth puts the can's bottom 10.6 mm below the table plane that the table's pixels
 // beside it confirm to 1 mm (docs/tracker.md), and the 1 cm default rejects the true pose.
 TEST(RealRecordingCliTest, FindsACanOnARealFrameFromItsOwnDetection) {
@@ -151,10 +157,7 @@ TEST(RealRecordingCliTest, FindsACanOnARealFrameFromItsOwnDetection) {
   const Scores can = TrackAndEval(dir, 1, "models_real/002_master_chef_can.obj", "detection",
                                   kReal / "data" / "unnamed_can",
                                   "--set tracker.verification.max_penetration=0.02");
-  EXPECT_LT(can.median_rotation_deg, 4.0);
-  EXPECT_LT(can.median_translation_mm, 5.0);
-  EXPECT_EQ(can.recall_5deg_5cm, 1.0);
-  EXPECT_GE(can.ar, 0.9);
+  ExpectNoWorseThan(can, {1.844, 2.398, 1.0, 0.967});
   // With the default table check the true pose is refused, as the test's comment says.
   const auto strict = RunMmh("track --quiet --input " + (kReal / "data" / "unnamed_can").string() +
                              " --model " + (kReal / "models_real" / "002_master_chef_can.obj").string() +
@@ -170,55 +173,49 @@ TEST(RealRecordingCliTest, FindsACanOnARealFrameFromItsOwnDetection) {
 // true pose explains 27 % of the points (< 0.5) and the track is lost on the first frame; each
 // detection then takes a pose turned about the mug's axis (120 deg: the handle is hidden behind
 // the mug). tracker.detection.own_segment_share = 0.6 scores a pose on the segments that lie on the
-// model. Measured (docs/tracker.md, "The sim-to-real gap"): from the truth's first pose 2.04 deg /
-// 0.73 mm, all 10 frames within 5 deg / 5 cm, AR 0.990; from its own detection 5.00 deg / 0.87 mm,
-// 5 of 10 within 5 deg / 5 cm, AR 0.942 (the error is a turn about the mug's axis, which the
-// hidden handle leaves open: the axis itself is 0.3-2.9 deg off). Without the option: 119.7 deg.
+// model. Measured (docs/tracker.md, "The sim-to-real gap"): from the truth's first pose 2.040 deg /
+// 0.731 mm, all 10 frames within 5 deg / 5 cm, AR 0.990; from its own detection 4.996 deg /
+// 0.866 mm, 5 of 10 within 5 deg / 5 cm, AR 0.942 (the error is a turn about the mug's axis, which
+// the hidden handle leaves open: the axis itself is 0.3-2.9 deg off; the issue's 2 deg and 90 %
+// are missed). Without the option: 119.7 deg, none of the 10 frames within 5 deg / 5 cm.
 TEST(RealRecordingCliTest, TracksTheMugWithItsScannedMesh) {
   TempDir dir;
   const std::string own = "--set tracker.detection.own_segment_share=0.6";
-  const Scores truth = TrackAndEval(dir, 14, "models_real/025_mug.obj", "truth", kVideo, own);
-  EXPECT_LT(truth.median_rotation_deg, 3.0);
-  EXPECT_LT(truth.median_translation_mm, 2.0);
-  EXPECT_GE(truth.recall_5deg_5cm, 0.9);
-  EXPECT_GE(truth.ar, 0.95);
-  const Scores detection =
-      TrackAndEval(dir, 14, "models_real/025_mug.obj", "detection", kVideo, own);
-  EXPECT_LT(detection.median_rotation_deg, 7.0);
-  EXPECT_LT(detection.median_translation_mm, 2.5);
-  EXPECT_GE(detection.ar, 0.9);
-  // The option's reason: without it the truth's pose is not kept.
+  ExpectNoWorseThan(TrackAndEval(dir, 14, "models_real/025_mug.obj", "truth", kVideo, own),
+                    {2.040, 0.731, 1.0, 0.990});
+  ExpectNoWorseThan(TrackAndEval(dir, 14, "models_real/025_mug.obj", "detection", kVideo, own),
+                    {4.996, 0.866, 0.5, 0.942});
+  // The option's reason: without it the truth's pose is not kept (measured 0 of 10 frames within
+  // 5 deg / 5 cm; the bound allows one).
   TempDir off;
   const Scores without = TrackAndEval(off, 14, "models_real/025_mug.obj", "truth");
-  EXPECT_LE(without.recall_5deg_5cm, 0.5);
+  EXPECT_LE(without.recall_5deg_5cm, kRecallMargin);
 }
 
 // The gelatin box with its real shape (the hull of the dataset's points) is found turned over from
 // its own detection: its half turns fill the same space and the depth cannot tell them apart.
 // tracker.appearance with the YCB scan's colours (models_real/009_gelatin_box_colour.ply,
 // PROVENANCE.md) picks, among the poses the depth scores alike, the one whose printed texture
-// agrees with the colour image. Not yet run (docs/tracker.md, "The gelatin box's colours": the
-// bounds are the issue's goals and the real hull's figures from the truth's first pose, 1.54 deg /
-// 0.89 mm, AR 1.0; without the option 178.2 deg / 8.05 mm, AR 0.333).
+// agrees with the colour image. Measured (docs/tracker.md, "The gelatin box's colours"): from its
+// own detection 1.526 deg / 0.877 mm, from the truth's first pose 1.538 deg / 0.891 mm, both with
+// all 10 frames within 5 deg / 5 cm and AR 1.000 (the issue's goals met, and the bounds inside
+// them); without the option 178.2 deg / 8.05 mm, AR 0.333.
 TEST(RealRecordingCliTest, TurnsTheGelatinBoxRightSideUpByItsColours) {
   TempDir dir;
   const std::string colours = "--set track.appearance_model=\\\"" +
                               (kReal / "models_real" / "009_gelatin_box_colour.ply").string() +
                               "\\\" --set tracker.appearance.margin=0.05";
-  // From either start: the medians below 3 deg and 2.5 mm, 90 % within 5 deg / 5 cm, AR 0.95.
-  for (const std::string init : {"detection", "truth"}) {
+  for (const auto& [init, measured] : {std::pair<std::string, Scores>{"detection", {1.526, 0.877, 1.0, 1.0}},
+                                       {"truth", {1.538, 0.891, 1.0, 1.0}}}) {
     SCOPED_TRACE(init);
-    const Scores scores =
-        TrackAndEval(dir, 8, "models_real/009_gelatin_box.obj", init, kVideo, colours);
-    EXPECT_LT(scores.median_rotation_deg, 3.0);
-    EXPECT_LT(scores.median_translation_mm, 2.5);
-    EXPECT_GE(scores.recall_5deg_5cm, 0.9);
-    EXPECT_GE(scores.ar, 0.95);
+    ExpectNoWorseThan(TrackAndEval(dir, 8, "models_real/009_gelatin_box.obj", init, kVideo, colours),
+                      measured);
   }
-  // The option's reason: without it the box is turned over (178 deg).
+  // The option's reason: without it the box is turned over (measured 178.2 deg; a detection on
+  // a single frame turns it 176.7-179.4 deg, docs/tracker.md; the bound allows 8 deg less).
   TempDir off;
   EXPECT_GT(TrackAndEval(off, 8, "models_real/009_gelatin_box.obj", "detection").median_rotation_deg,
-            90.0);
+            170.0);
 }
 
 // The header of an ASCII PLY with vertex colours (x y z red green blue) and triangles (12 lines).

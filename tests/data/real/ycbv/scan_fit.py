@@ -1,5 +1,5 @@
 # Fitting a YCB Object and Model Set scan into YCB-Video's model frame (make_mug_model.py,
-# make_gelatin_colour_model.py): ICP of the dataset's own model points (models_real/points/NAME.xyz,
+# make_colour_model.py): ICP of the dataset's own model points (models_real/points/NAME.xyz,
 # the frame of the ground-truth poses) onto the scan, with Blender's BVH tree for the closest points
 # on the triangles. Run inside Blender's Python (numpy and mathutils come with it).
 import math

@@ -1,12 +1,13 @@
-# The gelatin box's colour model (models_real/009_gelatin_box_colour.ply) in YCB-Video's model
-# frame, from the YCB Object and Model Set's own textured scan of 009_gelatin_box ("google_16k",
-# CC BY 4.0; PROVENANCE.md): the scan's geometry with a colour per vertex, baked from its texture.
-# The tracker's appearance check (tracker.appearance, docs/tracker.md) projects these colours into
-# the colour image to tell apart the poses the depth cannot (the box turned over); the tracker's
-# geometry stays the hull of the dataset's points (models_real/009_gelatin_box.obj).
+# An object's colour model (models_real/NAME_colour.ply: 009_gelatin_box, 002_master_chef_can) in
+# YCB-Video's model frame, from the YCB Object and Model Set's own textured scan of it
+# ("google_16k", CC BY 4.0; PROVENANCE.md): the scan's geometry with a colour per vertex, baked
+# from its texture. The tracker's appearance check (tracker.appearance, docs/tracker.md) projects
+# these colours into the colour image to tell apart the poses the depth cannot (the gelatin box
+# turned over); the tracker's geometry stays the hull of the dataset's points
+# (models_real/NAME.obj). NAME is the scan's file name without its extension.
 #   1. the scan read from MuJoCo's binary .msh (int32 counts of vertices, normals, texture
 #      coordinates and faces, then float32 positions, normals, (u, v) and int32 triangles);
-#   2. ICP of YCB-Video's own points (models_real/points/009_gelatin_box.xyz) onto the scan
+#   2. ICP of YCB-Video's own points (models_real/points/NAME.xyz) onto the scan
 #      (scan_fit.py), the scan moved by the fit's inverse;
 #   3. the texture (4096 x 4096) averaged over 16 x 16 blocks to 256 x 256 (a texel ~0.7 mm on the
 #      box: finer than the Xtion's pixel at 0.5-1 m), sampled bilinearly at each vertex's (u, v),
@@ -17,7 +18,8 @@
 #   4. written as binary little-endian PLY (x y z float, red green blue uchar; triangles), which
 #      mmh's PLY reader reads (a face's colour: the mean of its corners').
 # Run from this folder with Blender's Python, giving the scan and its texture:
-#   blender -b --factory-startup --python make_gelatin_colour_model.py -- 009_gelatin_box.msh 009_gelatin_box.png
+#   blender -b --factory-startup --python make_colour_model.py -- 009_gelatin_box.msh 009_gelatin_box.png
+#   blender -b --factory-startup --python make_colour_model.py -- 002_master_chef_can.msh 002_master_chef_can.png
 # Deterministic: the same inputs give the same file.
 import os
 import struct
@@ -69,8 +71,9 @@ def bilinear(texture, uv):
 
 
 scan_path, texture_path = sys.argv[sys.argv.index("--") + 1:][:2]
+name = os.path.splitext(os.path.basename(scan_path))[0]
 scan_vertices, uv, faces = read_msh(scan_path)
-points = np.loadtxt(os.path.join("models_real", "points", "009_gelatin_box.xyz"))
+points = np.loadtxt(os.path.join("models_real", "points", name + ".xyz"))
 r, t = fit_points_to_scan(points, scan_vertices, faces.tolist())
 moved = (scan_vertices - t) @ r
 tree = BVHTree.FromPolygons([tuple(v) for v in moved], faces.tolist())
@@ -80,16 +83,16 @@ colours = np.clip(np.rint(bilinear(read_texture(os.path.abspath(texture_path)), 
 colours = colours.astype(np.uint8)
 print("vertex colours: mean (%.1f, %.1f, %.1f)" % tuple(colours.mean(0)))
 
-out = os.path.join("models_real", "009_gelatin_box_colour.ply")
+out = os.path.join("models_real", name + "_colour.ply")
 with open(out, "wb") as f:
     header = ("ply\nformat binary_little_endian 1.0\n"
-              "comment YCB 009_gelatin_box (YCB Object and Model Set, google_16k scan, CC BY 4.0),\n"
+              "comment YCB %s (YCB Object and Model Set, google_16k scan, CC BY 4.0),\n"
               "comment moved into YCB-Video's model frame and its texture baked to vertex colours\n"
-              "comment by make_gelatin_colour_model.py; metres\n"
+              "comment by make_colour_model.py; metres\n"
               "element vertex %d\nproperty float x\nproperty float y\nproperty float z\n"
               "property uchar red\nproperty uchar green\nproperty uchar blue\n"
               "element face %d\nproperty list uchar int vertex_indices\nend_header\n" %
-              (len(moved), len(faces)))
+              (name, len(moved), len(faces)))
     f.write(header.encode("ascii"))
     vertex = np.zeros(len(moved), dtype=[("p", "<f4", 3), ("c", "u1", 3)])
     vertex["p"], vertex["c"] = moved, colours
