@@ -271,6 +271,21 @@ void RgbdFolderWriter::Add(const RgbdFrame& frame) {
   shared_->entries.emplace_back(frame.timestamp, name);
 }
 
+std::vector<std::pair<fs::path, fs::path>> RgbdFolderWriter::AddedImages() const {
+  std::vector<std::pair<double, std::string>> entries;
+  {
+    std::lock_guard<std::mutex> lock(shared_->mutex);
+    entries = shared_->entries;
+  }
+  std::sort(entries.begin(), entries.end());
+  std::vector<std::pair<fs::path, fs::path>> images;
+  images.reserve(entries.size());
+  for (const auto& [timestamp, name] : entries) {
+    images.emplace_back(fs::path("depth") / name, fs::path("rgb") / name);
+  }
+  return images;
+}
+
 void RgbdFolderWriter::Finish(const std::optional<Trajectory>& groundtruth,
                               const nlohmann::json& extra) {
   if (folder_.committed()) {

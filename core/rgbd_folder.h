@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/camera.h"
@@ -83,6 +84,11 @@ class RgbdFolderWriter {
 
   const std::filesystem::path& target() const { return folder_.target(); }
   const std::filesystem::path& staging() const { return folder_.staging(); }
+
+  // The images of every frame added so far, in timestamp order: (depth, rgb) paths relative to
+  // staging(), e.g. "depth/0.033333.png". For a second index of the same files before Finish()
+  // (the BOP scene of `mmh render`).
+  std::vector<std::pair<std::filesystem::path, std::filesystem::path>> AddedImages() const;
 
  private:
   struct Shared;  // the frame list and its mutex

@@ -8,8 +8,12 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <numbers>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "core/annotation.h"
 #include "core/atomic_file.h"
@@ -31,6 +35,28 @@ using Clock = std::chrono::steady_clock;
 
 Eigen::Quaterniond Yaw(double angle) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()));
+}
+
+// The BOP scene's images, depth/NNNNNN.png and rgb/NNNNNN.png by image id (BOP's layout, read by
+// bop_toolkit and by `mmh track` / `mmh eval`), are the TUM folder's own files: hard links, so no
+// second copy; copied where the file system refuses links. The depth scale of scene_camera.json is
+// the TUM folder's, and the colour images are registered to the depth camera (one cam_K).
+void LinkBopImages(const std::filesystem::path& staging,
+                   const std::vector<std::pair<std::filesystem::path, std::filesystem::path>>& images,
+                   const std::filesystem::path& scene) {
+  EnsureDirectory(scene / "depth");
+  EnsureDirectory(scene / "rgb");
+  for (size_t id = 0; id < images.size(); ++id) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06zu.png", id);
+    for (const auto& [source, folder] :
+         {std::pair{images[id].first, "depth"}, std::pair{images[id].second, "rgb"}}) {
+      const std::filesystem::path target = scene / folder / name;
+      std::error_code error;
+      std::filesystem::create_hard_link(staging / source, target, error);
+      if (error) std::filesystem::copy_file(staging / source, target);
+    }
+  }
 }
 
 }  // namespace
@@ -354,6 +380,7 @@ RenderSummary RenderSequence(
     EnsureDirectory(staging / "bop" / "models");
     WriteBopScene(staging / "bop", bop, camera.depth_intrinsics, camera.depth_scale);
     WritePly(proxy_model, staging / "bop" / "models" / "obj_000001.ply", 1000.0);
+    LinkBopImages(staging, writer.AddedImages(), staging / "bop");
   }
   if (before_commit) before_commit(staging, summary);
   writer.Finish(groundtruth, {{"scene", scene_json}});
