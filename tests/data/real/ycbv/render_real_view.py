@@ -60,6 +60,9 @@ def main():
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--ir-albedo", type=float, default=0.6)
     parser.add_argument("--specularity", type=float, default=0.05)
+    parser.add_argument("--no-paths", dest="paths", action="store_false",
+                        help="leave render.proxy and render.trajectory out of render.json (given "
+                             "with --set instead: the committed views/ of the tests)")
     args = parser.parse_args()
 
     summary = json.load(open(os.path.join(args.track_folder, "track_summary.json")))
@@ -83,7 +86,8 @@ def main():
         raise SystemExit(f"{args.track_folder}/groundtruth.tum: no poses")
 
     os.makedirs(args.out, exist_ok=True)
-    trajectory = os.path.join(os.path.abspath(args.out), "table_T_proxy.tum")
+    trajectory = os.path.join(os.path.abspath(args.out), "table_T_proxy.tum" if args.paths else
+                              os.path.basename(args.model).rsplit(".", 1)[0] + f"_{args.motion}.tum")
     with open(trajectory, "w") as out:
         out.write(f"# table_T_proxy: {args.motion} view of {os.path.basename(args.model)} from "
                   f"{args.track_folder} (render_real_view.py)\n")
@@ -101,19 +105,22 @@ def main():
             q = matrix_to_quaternion(r)
             out.write("%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n" % (k / 30, *t, *q))
 
+    render = {"frames": len(rows), "hand": False, "slider": False, "bop": True}
+    if args.paths:
+        render.update({"proxy": os.path.abspath(args.model), "trajectory": trajectory})
     config = {
-        "render": {"frames": len(rows), "proxy": os.path.abspath(args.model),
-                   "trajectory": trajectory, "hand": False, "slider": False, "bop": True},
+        "render": render,
         "camera": {"x": t_tc[0], "y": t_tc[1], "z": t_tc[2],
                    "look_at_x": look_at[0], "look_at_y": look_at[1], "look_at_z": look_at[2]},
         "scene": {"materials": {"proxy": {"ir_albedo": args.ir_albedo,
                                           "specularity": args.specularity}}},
     }
-    with open(os.path.join(args.out, "render.json"), "w") as out:
+    name = "render.json" if args.paths else os.path.basename(args.model).rsplit(".", 1)[0] + f"_{args.motion}.json"
+    with open(os.path.join(args.out, name), "w") as out:
         json.dump(config, out, indent=2)
         out.write("\n")
     print(f"camera at {t_tc[0]:.3f} {t_tc[1]:.3f} {t_tc[2]:.3f} m, {along:.3f} m from the table "
-          f"along its axis; {len(rows)} frames -> {args.out}/render.json")
+          f"along its axis; {len(rows)} frames -> {args.out}/{name}")
 
 
 if __name__ == "__main__":
