@@ -86,8 +86,10 @@ def main():
         raise SystemExit(f"{args.track_folder}/groundtruth.tum: no poses")
 
     os.makedirs(args.out, exist_ok=True)
-    trajectory = os.path.join(os.path.abspath(args.out), "table_T_proxy.tum" if args.paths else
-                              os.path.basename(args.model).rsplit(".", 1)[0] + f"_{args.motion}.tum")
+    # render.json + table_T_proxy.tum, or (--no-paths, several views in one folder) NAME_MOTION.*
+    stem = os.path.basename(args.model).rsplit(".", 1)[0] + f"_{args.motion}"
+    trajectory = os.path.join(os.path.abspath(args.out),
+                              "table_T_proxy.tum" if args.paths else stem + ".tum")
     with open(trajectory, "w") as out:
         out.write(f"# table_T_proxy: {args.motion} view of {os.path.basename(args.model)} from "
                   f"{args.track_folder} (render_real_view.py)\n")
@@ -115,7 +117,7 @@ def main():
         "scene": {"materials": {"proxy": {"ir_albedo": args.ir_albedo,
                                           "specularity": args.specularity}}},
     }
-    name = "render.json" if args.paths else os.path.basename(args.model).rsplit(".", 1)[0] + f"_{args.motion}.json"
+    name = "render.json" if args.paths else stem + ".json"
     with open(os.path.join(args.out, name), "w") as out:
         json.dump(config, out, indent=2)
         out.write("\n")
