@@ -52,9 +52,12 @@ void ExpectNoWorseThan(const Scores& got, const Scores& measured) {
 
 // `model` under tests/data/real/ycbv (models/: the fitted cuboids; models_real/: the hulls of the
 // dataset's own model points), `video` a folder of it, `extra` more flags for `mmh track`.
+// `tag` names the output folders apart when one test tracks several recordings' same object;
+// `frames` is the recording's length (default: 10 for video 0000, else 1).
 Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, const std::string& init,
-                    const fs::path& video = kVideo, const std::string& extra = "") {
-  const fs::path out = dir / ("track_" + init + std::to_string(object));
+                    const fs::path& video = kVideo, const std::string& extra = "",
+                    const std::string& tag = "", int frames = 0) {
+  const fs::path out = dir / (tag + "track_" + init + std::to_string(object));
   const auto track = RunMmh("track --quiet --input " + video.string() + " --model " +
                             (kReal / model).string() + " --config " + kPreset +
                             " --set track.object=" + std::to_string(object) +
@@ -64,7 +67,7 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
   const auto summary = nlohmann::json::parse(ReadBytes(out / "track_summary.json"));
   EXPECT_EQ(summary["init"], init);
   EXPECT_TRUE(fs::exists(out / "groundtruth.tum"));
-  const fs::path eval = dir / ("eval_" + init + std::to_string(object));
+  const fs::path eval = dir / (tag + "eval_" + init + std::to_string(object));
   const auto result = RunMmh("eval --quiet --input " + video.string() + " --model " +
                              (kReal / model).string() + " --estimate " +
                              (out / "trajectory.tum").string() + " --set track.object=" +
@@ -72,7 +75,7 @@ Scores TrackAndEval(const TempDir& dir, int object, const std::string& model, co
   EXPECT_EQ(result.exit_code, 0) << result.output;
   const auto json = nlohmann::json::parse(ReadBytes(eval / "eval.json"));
   const auto& o = json["objects"][0];
-  EXPECT_EQ(o["frames"], video == kVideo ? 10 : 1);
+  EXPECT_EQ(o["frames"], frames > 0 ? frames : video == kVideo ? 10 : 1);
   EXPECT_FALSE(o["ar_vsd"].is_null());
   return {o["median_rotation_deg"], o["median_translation_mm"], o["recall_5deg_5cm"], o["ar"]};
 }
@@ -110,20 +113,7 @@ TEST(RealRecordingCliTest, TheRealViewRenderedGivesTheTrackerNoMoreErrorThanTheR
                           (kReal / "views" / "009_gelatin_box_static.tum").string() +
                           "\\\" --set sensor.mode=\\\"" + mode + "\\\" --out " + render.string());
     EXPECT_EQ(r.exit_code, 0) << r.output;
-    const fs::path track = dir / ("track_" + mode);
-    const auto t = RunMmh("track --quiet --input " + (render / "bop").string() + " --model " +
-                          (kReal / model).string() + " --config " + kPreset +
-                          " --set track.init=\\\"truth\\\" --out " + track.string());
-    EXPECT_EQ(t.exit_code, 0) << t.output;
-    const fs::path eval = dir / ("eval_" + mode);
-    const auto e = RunMmh("eval --quiet --input " + (render / "bop").string() + " --model " +
-                          (kReal / model).string() + " --estimate " +
-                          (track / "trajectory.tum").string() + " --out " + eval.string());
-    EXPECT_EQ(e.exit_code, 0) << e.output;
-    const auto o = nlohmann::json::parse(ReadBytes(eval / "eval.json"))["overall"];
-    EXPECT_EQ(o["frames"], 10);
-    return Scores{o["median_rotation_deg"], o["median_translation_mm"], o["recall_5deg_5cm"],
-                  o["ar"]};
+    return TrackAndEval(dir, 1, model, "truth", render / "bop", "", mode, 10);
   };
   const Scores structured = rendered("structured_light");
   const Scores statistical = rendered("statistical");
