@@ -17,4 +17,10 @@ double RotationAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   return 2.0 * std::atan2(d.vec().norm(), std::abs(d.w()));
 }
 
+Eigen::Vector3d RotationVector(Eigen::Quaterniond q) {
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  const Eigen::AngleAxisd aa(q);
+  return aa.axis() * aa.angle();
+}
+
 }  // namespace mmh

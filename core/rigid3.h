@@ -44,4 +44,8 @@ inline double WrapAngle(double angle) { return std::remainder(angle, 2 * 3.14159
 // Angle of the rotation from a to b in radians, in [0, pi].
 double RotationAngle(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b);
 
+// The rotation vector of a unit quaternion: axis times angle, along the shorter arc (angle in
+// [0, pi]).
+Eigen::Vector3d RotationVector(Eigen::Quaterniond q);
+
 }  // namespace mmh

@@ -7,16 +7,6 @@
 #include "people/random.h"
 
 namespace mmh::people {
-namespace {
-
-// Rotation vector of q (axis times angle, shorter arc).
-Eigen::Vector3d RotationVector(Eigen::Quaterniond q) {
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  const Eigen::AngleAxisd aa(q);
-  return aa.axis() * aa.angle();
-}
-
-}  // namespace
 
 void ViewerOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(artefact_weight, prefix + ".artefact_weight");

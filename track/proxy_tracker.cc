@@ -38,6 +38,7 @@ ProxyTracker::ProxyTracker(const TriangleMesh& model, const std::string& model_n
   setup_.Validate("setup");
   model_ = std::make_unique<ProxyModel>(model, options_.model, model_name);
   motion_.emplace(options_.motion, model_->centroid().cast<double>(), model_->radius());
+  output_filter_ = PoseFilter(options_.output_filter);
   search_icp_ = options_.icp;
   search_icp_.prior_rotation_deg = 0;
   search_icp_.prior_translation = 0;
@@ -70,6 +71,7 @@ ProxyTracker::~ProxyTracker() = default;
 
 void ProxyTracker::Initialize(const Rigid3& camera_T_proxy) {
   motion_->Reset();
+  output_filter_.Reset();
   motion_->Measure(camera_T_proxy, false);
   predicted_frames_ = 0;
   tracked_frames_ = 0;
@@ -82,6 +84,7 @@ TrackFrameResult ProxyTracker::Unreadable(const RgbdFrame& frame, const std::str
   result.timestamp = frame.timestamp;
   result.reason = "unreadable frame: " + error;
   motion_->Reset();
+  output_filter_.Reset();
   return result;
 }
 
@@ -931,6 +934,16 @@ void ProxyTracker::ReportTracked(const RgbdFrame& frame, const Candidate& chosen
 }
 
 TrackFrameResult ProxyTracker::Track(const RgbdFrame& frame) {
+  TrackFrameResult result = TrackUnfiltered(frame);
+  if (!options_.output_filter.enabled) return result;
+  if (result.status == TrackStatus::kLost || result.detected) output_filter_.Reset();
+  if (result.status != TrackStatus::kLost) {
+    result.camera_T_proxy = output_filter_.Filter(result.timestamp, result.camera_T_proxy);
+  }
+  return result;
+}
+
+TrackFrameResult ProxyTracker::TrackUnfiltered(const RgbdFrame& frame) {
   TrackFrameResult result;
   result.index = frame.index;
   result.timestamp = frame.timestamp;

@@ -20,6 +20,7 @@
 #include "core/triangle_mesh.h"
 #include "track/appearance.h"
 #include "track/motion_model.h"
+#include "track/pose_filter.h"
 #include "track/point_to_plane_icp.h"
 #include "track/projective_refinement.h"
 #include "track/proxy_model.h"
@@ -232,6 +233,8 @@ struct ProxyTrackerOptions {
   // The colour check among the depth's equivalent poses (track/appearance.h; off by default, and
   // then without effect: it needs SetAppearanceModel).
   AppearanceOptions appearance;
+  // The low-pass on the reported poses (track/pose_filter.h; off by default).
+  PoseFilterOptions output_filter;
 
   template <class V>
   void VisitFields(V& v) {
@@ -244,6 +247,7 @@ struct ProxyTrackerOptions {
     v("detection", detection);
     v("verification", verification);
     v("appearance", appearance);
+    v("output_filter", output_filter);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -287,7 +291,9 @@ class ProxyTracker {
   void SetAppearanceModel(std::shared_ptr<const AppearanceModel> appearance);
 
   // Tracks one frame. Never throws for a bad frame: a frame of the wrong size, with other
-  // intrinsics than the first, without depth or without a table is lost with the reason.
+  // intrinsics than the first, without depth or without a table is lost with the reason. With
+  // output_filter.enabled the reported pose is the filtered one (restarted at a detection and
+  // after a loss).
   TrackFrameResult Track(const RgbdFrame& frame);
   // The frame could not be read (FrameSource::frame_error): lost with that reason.
   TrackFrameResult Unreadable(const RgbdFrame& frame, const std::string& error);
@@ -335,6 +341,8 @@ class ProxyTracker {
   // frame's data, and verifies it (the rival's and the slide check's refinement).
   Candidate RefineOnFrame(const RgbdFrame& frame, const Rigid3& camera_T_start);
   // Track's steps. Lose: the frame is lost (the motion, the rival and the recent score reset).
+  // Track() before the output filter.
+  TrackFrameResult TrackUnfiltered(const RgbdFrame& frame);
   TrackFrameResult Lose(TrackFrameResult result, const std::string& reason);
   // What makes the frame unusable (wrong size, other intrinsics, no depth), or "".
   std::string FrameProblem(const RgbdFrame& frame) const;
@@ -424,6 +432,8 @@ class ProxyTracker {
   std::optional<Rigid3> camera_T_table_;
   // Motion state: the motion model (set in the constructor) and the frames predicted since.
   std::optional<MotionModel> motion_;
+  // The reported poses' low-pass (used only when options_.output_filter.enabled).
+  PoseFilter output_filter_{PoseFilterOptions{}};
   int predicted_frames_ = 0;
   int frames_since_detection_ = 0;
   int tracked_frames_ = 0;  // measured frames since the last loss

@@ -96,6 +96,7 @@ void ProxyTrackerOptions::Validate(const std::string& prefix) const {
   projective.Validate(prefix + ".projective");
   motion.Validate(prefix + ".motion");
   detection.Validate(prefix + ".detection");
+  output_filter.Validate(prefix + ".output_filter");
   verification.Validate(prefix + ".verification");
   appearance.Validate(prefix + ".appearance");
 }

@@ -223,6 +223,35 @@ TEST(ProxyTrackerTest, SoldierSideViewDoesNotSlideUpItsFaces) {
   EXPECT_TRUE(result.summary.all_recovered);
 }
 
+// The output filter (tracker.output_filter, track/pose_filter.h) changes only what is reported:
+// the tracker's own state keeps the unfiltered poses, so the statuses are those of the unfiltered
+// run, and every reported pose is the filter applied to the unfiltered run's poses (restarted at
+// each detection and after each loss).
+TEST(ProxyTrackerTest, OutputFilterChangesOnlyTheReportedPoses) {
+  constexpr int kFrames = 45;
+  ProxyTrackerOptions filtered_options;
+  filtered_options.output_filter.enabled = true;
+  test_take::SimTake plain_take;
+  test_take::SimTake filtered_take;
+  const TakeResult plain = TrackTake(plain_take, kFrames);
+  const TakeResult filtered = TrackTake(filtered_take, kFrames, filtered_options);
+  PoseFilter oracle(filtered_options.output_filter);
+  int differing = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    const TrackFrameResult& p = plain.frames[i];
+    const TrackFrameResult& f = filtered.frames[i];
+    ASSERT_EQ(p.status, f.status) << i;
+    ASSERT_EQ(p.detected, f.detected) << i;
+    if (p.status == TrackStatus::kLost || p.detected) oracle.Reset();
+    if (p.status == TrackStatus::kLost) continue;
+    const Rigid3 expected = oracle.Filter(p.timestamp, p.camera_T_proxy);
+    EXPECT_LT((expected.translation - f.camera_T_proxy.translation).norm(), 1e-12) << i;
+    EXPECT_LT(RotationAngle(expected.rotation, f.camera_T_proxy.rotation), 1e-9) << i;
+    differing += (p.camera_T_proxy.translation - f.camera_T_proxy.translation).norm() > 1e-5;
+  }
+  EXPECT_GE(differing, kFrames / 2);
+}
+
 TEST(ProxyTrackerTest, SlideDropMustNotBeNegative) {
   ProxyTrackerOptions options;
   options.detection.slide_drop = -0.01;
