@@ -56,11 +56,9 @@ Rigid3 PoseFilter::Filter(double timestamp, const Rigid3& camera_T_proxy) {
       RotationVector(pose_.rotation.conjugate() * camera_T_proxy.rotation) / dt;
   angular_ += alpha_d * (angular - angular_);
   const double rotation_cutoff = options_.min_cutoff_hz + options_.rotation_beta * angular_.norm();
-  // slerp along the shorter arc (Interpolate's convention).
-  pose_.rotation = Interpolate(Rigid3(pose_.rotation, Eigen::Vector3d::Zero()),
-                               Rigid3(camera_T_proxy.rotation, Eigen::Vector3d::Zero()),
-                               Alpha(rotation_cutoff, dt))
-                       .rotation.normalized();
+  // Eigen's slerp takes the shorter arc.
+  pose_.rotation =
+      pose_.rotation.slerp(Alpha(rotation_cutoff, dt), camera_T_proxy.rotation).normalized();
   return pose_;
 }
 

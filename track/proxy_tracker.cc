@@ -33,12 +33,14 @@ struct ProxyTracker::Candidate {
 
 ProxyTracker::ProxyTracker(const TriangleMesh& model, const std::string& model_name,
                            const TrackSetup& setup, const ProxyTrackerOptions& options)
-    : options_(options), setup_(setup), segmenter_(options.segmentation, setup) {
+    : options_(options),
+      setup_(setup),
+      segmenter_(options.segmentation, setup),
+      output_filter_(options.output_filter) {
   options_.Validate("tracker");
   setup_.Validate("setup");
   model_ = std::make_unique<ProxyModel>(model, options_.model, model_name);
   motion_.emplace(options_.motion, model_->centroid().cast<double>(), model_->radius());
-  output_filter_ = PoseFilter(options_.output_filter);
   search_icp_ = options_.icp;
   search_icp_.prior_rotation_deg = 0;
   search_icp_.prior_translation = 0;

@@ -20,8 +20,8 @@
 #include "core/triangle_mesh.h"
 #include "track/appearance.h"
 #include "track/motion_model.h"
-#include "track/pose_filter.h"
 #include "track/point_to_plane_icp.h"
+#include "track/pose_filter.h"
 #include "track/projective_refinement.h"
 #include "track/proxy_model.h"
 #include "track/segmentation.h"
@@ -433,7 +433,7 @@ class ProxyTracker {
   // Motion state: the motion model (set in the constructor) and the frames predicted since.
   std::optional<MotionModel> motion_;
   // The reported poses' low-pass (used only when options_.output_filter.enabled).
-  PoseFilter output_filter_{PoseFilterOptions{}};
+  PoseFilter output_filter_;
   int predicted_frames_ = 0;
   int frames_since_detection_ = 0;
   int tracked_frames_ = 0;  // measured frames since the last loss

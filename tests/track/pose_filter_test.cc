@@ -148,14 +148,13 @@ TEST(PoseFilterTest, ARampLagsByTheSmoothersLagAndLessWithBeta) {
 }
 
 TEST(PoseFilterTest, BadOptionsNameTheKeyAndTheValue) {
-  for (const auto& [key, value] :
-       {std::tuple{"min_cutoff_hz", 0.0}, std::tuple{"derivative_cutoff_hz", -1.0},
-        std::tuple{"translation_beta", -0.5}, std::tuple{"rotation_beta", std::nan("")}}) {
+  for (const auto& [field, key, value] :
+       {std::tuple{&PoseFilterOptions::min_cutoff_hz, "min_cutoff_hz", 0.0},
+        std::tuple{&PoseFilterOptions::derivative_cutoff_hz, "derivative_cutoff_hz", -1.0},
+        std::tuple{&PoseFilterOptions::translation_beta, "translation_beta", -0.5},
+        std::tuple{&PoseFilterOptions::rotation_beta, "rotation_beta", std::nan("")}}) {
     PoseFilterOptions options;
-    if (std::string(key) == "min_cutoff_hz") options.min_cutoff_hz = value;
-    if (std::string(key) == "derivative_cutoff_hz") options.derivative_cutoff_hz = value;
-    if (std::string(key) == "translation_beta") options.translation_beta = value;
-    if (std::string(key) == "rotation_beta") options.rotation_beta = value;
+    options.*field = value;
     try {
       options.Validate("tracker.output_filter");
       ADD_FAILURE() << "no error for " << key;
