@@ -74,6 +74,7 @@ ProxyTracker::~ProxyTracker() = default;
 void ProxyTracker::Initialize(const Rigid3& camera_T_proxy) {
   motion_->Reset();
   output_filter_.Reset();
+  reacquire_pose_.reset();
   motion_->Measure(camera_T_proxy, false);
   predicted_frames_ = 0;
   tracked_frames_ = 0;
@@ -84,10 +85,8 @@ TrackFrameResult ProxyTracker::Unreadable(const RgbdFrame& frame, const std::str
   TrackFrameResult result;
   result.index = frame.index;
   result.timestamp = frame.timestamp;
-  result.reason = "unreadable frame: " + error;
-  motion_->Reset();
   output_filter_.Reset();
-  return result;
+  return Lose(result, "unreadable frame: " + error);
 }
 
 bool ProxyTracker::EnsureTable(const RgbdFrame& frame, std::string* why) {
@@ -451,7 +450,9 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::Detect(const RgbdFrame& fra
   size_t coarse_scored = 1;
   if (!light) {
     coarse_results = CoarseHypotheses(coarse_icp, &coarse_scored);
-    if (coarse_results.empty()) return std::nullopt;
+    // Without a segment large enough for them (a hand over the proxy breaks it into pieces), the
+    // motion model's seeds alone, when there are any.
+    if (coarse_results.empty() && !predicted) return std::nullopt;
   }
   const std::vector<size_t> order = RankCoarse(frame, coarse_results, coarse_scored);
   // Candidates are refined and ranked on at most refine_points segmented points (and the skin
@@ -737,6 +738,15 @@ bool ProxyTracker::WeighRival(const RgbdFrame& frame, Candidate* chosen) {
 TrackFrameResult ProxyTracker::Lose(TrackFrameResult result, const std::string& reason) {
   result.status = TrackStatus::kLost;
   result.reason = reason;
+  // The pose to re-acquire from (DetectionOptions::reacquire_frames): the last measured one, kept
+  // for reacquire_frames lost frames.
+  if (motion_->last()) {
+    reacquire_pose_ = motion_->last();
+    reacquire_age_ = 0;
+  } else if (reacquire_pose_ && ++reacquire_age_ >= options_.detection.reacquire_frames) {
+    reacquire_pose_.reset();
+  }
+  if (options_.detection.reacquire_frames == 0) reacquire_pose_.reset();
   motion_->Reset();
   predicted_frames_ = 0;
   tracked_frames_ = 0;
@@ -886,11 +896,26 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::TrackFromPrediction(
 
 std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAfterLoss(
     const RgbdFrame& frame, const std::optional<Rigid3>& predicted, TrackFrameResult* result,
-    std::string* why) {
+    std::string* why, bool* held) {
   std::optional<Candidate> detected = options_.detection.model_segments > 0
                                           ? DetectAmongSegments(frame, predicted)
                                           : Detect(frame, predicted, false);
   frames_since_detection_ = 0;
+  const double pi = std::numbers::pi;
+  if (detected && detected->good && predicted && options_.detection.hold_trusted &&
+      options_.detection.rival_threshold > 0 &&
+      tracked_frames_ >= options_.detection.trusted_frames &&
+      RotationAngle(detected->icp.proxy_T_camera.Inverse().rotation, predicted->rotation) >
+          3 * pi / 4) {
+    // A trusted track whose pose failed its verification does not leave for its half-turn twin on
+    // the verification alone: the twin becomes the rival (its evidence decides, WeighRival) and
+    // the frame is held (predicted). A pose less than 135 deg from the prediction may be a fast
+    // turn the prediction missed (a Soldier turned by 40 deg in a few frames) and is taken.
+    SetRival(predicted->Inverse() * detected->icp.proxy_T_camera.Inverse(), false);
+    *held = true;
+    *why = "only a twin of the trusted pose verified (held)";
+    return std::nullopt;
+  }
   if (detected && detected->good) {
     result->detected = true;
     // The twin evidence survives a detection that continues the track (the tracked pose failed
@@ -898,7 +923,7 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAfterLoss(
     // turns it onto a twin.
     SetRival(detection_rival_,
              !predicted || RotationAngle(detected->icp.proxy_T_camera.Inverse().rotation,
-                                         predicted->rotation) > std::numbers::pi / 4);
+                                         predicted->rotation) > pi / 4);
     return detected;
   }
   if (why->empty()) {
@@ -970,11 +995,24 @@ TrackFrameResult ProxyTracker::TrackUnfiltered(const RgbdFrame& frame) {
   // Lost or none: the detection looks at the whole play area (a jump may have left the window).
   if (!chosen && windowed) SegmentFrame(frame, nullptr, &result);
   const bool enough = result.points >= options_.verification.min_points;
-  if (!chosen && enough) chosen = DetectAfterLoss(frame, predicted, &result, &why);
+  bool held = false;
+  if (!chosen && enough) {
+    // After a loss, the pose before it seeds the detection and breaks its ties.
+    chosen = DetectAfterLoss(frame, predicted ? predicted : reacquire_pose_, &result, &why, &held);
+  }
   if (chosen) {
+    reacquire_pose_.reset();
     const bool slid = !result.detected && CheckSlide(frame, &*chosen);
     if (WeighRival(frame, &*chosen)) result.detected = true;
     ReportTracked(frame, *chosen, slid, &result);
+    return result;
+  }
+  if (held && motion_->last() && predicted_frames_ < options_.verification.max_predicted_frames) {
+    // Held: extrapolated as when hidden, but the track stays trusted and keeps its rival.
+    ++predicted_frames_;
+    result.status = TrackStatus::kPredicted;
+    result.camera_T_proxy = motion_->Coast();
+    result.reason = why;
     return result;
   }
   if (!enough) {

@@ -124,6 +124,20 @@ struct DetectionOptions {
   // detection took another pose.
   double own_segment_share = 0.0;
   double own_segment_distance = 0.01;
+  // After a loss, the last measured pose stays a seed of the detection (with its displaced
+  // variants, and as the reference continuity breaks ties against) for this many frames (0: the
+  // loss forgets it). A loss is mostly one frame that failed its verification under the hand, and
+  // the proxy is still near where it was; the detection from the coarse hypotheses alone needs a
+  // segment of min_points, which a hand over the proxy breaks into pieces.
+  int reacquire_frames = 30;
+  // A trusted track (trusted_frames) whose pose fails its verification does not leave for a pose
+  // more than 135 deg from the prediction that the detection verifies (a half-turn twin): that
+  // pose becomes the rival, and the frame is predicted (extrapolated, up to
+  // verification.max_predicted_frames). Without this
+  // the verification alone switches a trusted track into its twin, which the twin evidence exists
+  // to prevent: on structured-light frames under the hand the true pose's inlier share falls just
+  // under min_inlier_share while the twin's does not.
+  bool hold_trusted = true;
 
   template <class V>
   void VisitFields(V& v) {
@@ -154,6 +168,8 @@ struct DetectionOptions {
     v("segment_slack", segment_slack);
     v("own_segment_share", own_segment_share);
     v("own_segment_distance", own_segment_distance);
+    v("reacquire_frames", reacquire_frames);
+    v("hold_trusted", hold_trusted);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -361,9 +377,11 @@ class ProxyTracker {
                                                bool* windowed, TrackFrameResult* result,
                                                std::string* why);
   // The detection after a loss (or on the first frame): a verified pose, or nullopt with *why.
+  // *held: the detection found only a twin of a trusted track (DetectionOptions::hold_trusted).
   std::optional<Candidate> DetectAfterLoss(const RgbdFrame& frame,
                                            const std::optional<Rigid3>& predicted,
-                                           TrackFrameResult* result, std::string* why);
+                                           TrackFrameResult* result, std::string* why,
+                                           bool* held);
   // The chosen pose reported (projectively refined), measured by the motion model, and the
   // background learnt around it; `slid`: moved by the slide check (no motion).
   void ReportTracked(const RgbdFrame& frame, const Candidate& chosen, bool slid,
@@ -447,6 +465,10 @@ class ProxyTracker {
   std::optional<Rigid3> proxy_T_rival_;
   std::optional<Rigid3> detection_rival_;
   double rival_evidence_ = 0.0;
+  // The last measured pose before the loss and the frames lost since
+  // (DetectionOptions::reacquire_frames); nullopt while tracking or once too old.
+  std::optional<Rigid3> reacquire_pose_;
+  int reacquire_age_ = 0;
   // The exponential average of the tracked poses' scores (the slide check's reference); nullopt
   // after a loss.
   std::optional<double> recent_score_;

@@ -63,6 +63,9 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   if (trusted_frames < 0) {
     ThrowBadValue(prefix + ".trusted_frames", std::to_string(trusted_frames), ">= 0");
   }
+  if (reacquire_frames < 0) {
+    ThrowBadValue(prefix + ".reacquire_frames", std::to_string(reacquire_frames), ">= 0 (0: off)");
+  }
   RequireProbability(recheck_free_space, prefix + ".recheck_free_space");
   if (coarse_end_distance > coarse_start_distance) {
     ThrowBadValue(prefix + ".coarse_end_distance", FormatNumber(coarse_end_distance),
