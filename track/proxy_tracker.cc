@@ -743,6 +743,7 @@ TrackFrameResult ProxyTracker::Lose(TrackFrameResult result, const std::string& 
   if (motion_->last()) {
     reacquire_pose_ = motion_->last();
     reacquire_age_ = 0;
+    reacquire_trust_ = tracked_frames_;
   } else if (reacquire_pose_ && ++reacquire_age_ >= options_.detection.reacquire_frames) {
     reacquire_pose_.reset();
   }
@@ -998,6 +999,11 @@ TrackFrameResult ProxyTracker::TrackUnfiltered(const RgbdFrame& frame) {
   bool held = false;
   if (!chosen && enough) {
     // After a loss, the pose before it seeds the detection and breaks its ties.
+    // ... and continues the track's trust (DetectionOptions::reacquire_trust_frames).
+    if (!predicted && reacquire_pose_ &&
+        reacquire_age_ < options_.detection.reacquire_trust_frames) {
+      tracked_frames_ = reacquire_trust_;
+    }
     chosen = DetectAfterLoss(frame, predicted ? predicted : reacquire_pose_, &result, &why, &held);
   }
   if (chosen) {

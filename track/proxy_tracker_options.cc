@@ -66,6 +66,10 @@ void DetectionOptions::Validate(const std::string& prefix) const {
   if (reacquire_frames < 0) {
     ThrowBadValue(prefix + ".reacquire_frames", std::to_string(reacquire_frames), ">= 0 (0: off)");
   }
+  if (reacquire_trust_frames < 0) {
+    ThrowBadValue(prefix + ".reacquire_trust_frames", std::to_string(reacquire_trust_frames),
+                  ">= 0 (0: never)");
+  }
   RequireProbability(recheck_free_space, prefix + ".recheck_free_space");
   if (coarse_end_distance > coarse_start_distance) {
     ThrowBadValue(prefix + ".coarse_end_distance", FormatNumber(coarse_end_distance),

@@ -384,52 +384,89 @@ TEST(ProxyTrackerTest, ALossIsReacquiredFromThePoseBeforeIt) {
   }
 }
 
-// A trusted track is held against its half-turn twin (DetectionOptions::hold_trusted).
-// Structured-light frames with the camera at 0.85 m (docs/tracker.md, "Structured light at
-// 0.85 m: losses and flips"), configs/soldier.json's participant 0, take 1, frames 0-269: at frame
-// 254 the hand over the Soldier's head drops the tracked pose's inlier share just under 0.75 and
-// the detection verifies only the twin. Two trackers see the same frames: with the hold that frame
-// is predicted and the track stays on the truth; without it the track switches into the twin
-// (measured with `mmh track` on the whole take: 5 frames in the twin from frame 254).
-TEST(ProxyTrackerTest, StructuredLightTrustedTrackIsHeldAgainstItsTwin) {
-  constexpr int kFrames = 270;
-  const std::filesystem::path dir = testing::TempDir() + "held_twin";
+// A story take (`config_file`: configs/soldier.json or configs/mario.json, participant 0) on
+// structured-light frames with the camera at 0.85 m (docs/tracker.md, "Losses and flips at
+// 0.85 m").
+test_take::SimTake StructuredLightStoryTake(const std::string& config_file, int take_index,
+                                            int* take_frames) {
+  const std::filesystem::path dir = testing::TempDir() + "structured_light_story";
   std::filesystem::create_directories(dir);
-  nlohmann::json config = nlohmann::json::parse(
-      std::ifstream(std::string(MMH_SOURCE_DIR) + "/configs/soldier.json"));
+  nlohmann::json config =
+      nlohmann::json::parse(std::ifstream(std::string(MMH_SOURCE_DIR) + "/" + config_file));
   config["sensor"]["mode"] = "structured_light";
   config["camera"]["y"] = -0.65;
   config["camera"]["z"] = 0.55;
-  const std::filesystem::path file = dir / "soldier_sl.json";
+  const std::filesystem::path file = dir / std::filesystem::path(config_file).filename();
   std::ofstream(file) << config.dump();
-  int take_frames = 0;
-  test_take::SimTake take = test_take::SoldierStorySession(
-      MMH_SOURCE_DIR, 0, 1, sim::RenderSession::kRecording, &take_frames,
-      std::filesystem::relative(file, MMH_SOURCE_DIR).string());
-  ASSERT_GE(take_frames, kFrames);
-  ProxyTrackerOptions unheld_options;
-  unheld_options.detection.hold_trusted = false;
-  ProxyTracker held(take.model(), "soldier", take.Setup(), {});
-  ProxyTracker unheld(take.model(), "soldier", take.Setup(), unheld_options);
-  int held_frames = 0, held_flips = 0, unheld_flips = 0;
+  return test_take::SoldierStorySession(MMH_SOURCE_DIR, 0, take_index,
+                                        sim::RenderSession::kRecording, take_frames,
+                                        std::filesystem::relative(file, MMH_SOURCE_DIR).string());
+}
+
+// Two trackers, with the default options and with `other`, see the same first `frames` frames of
+// `take`: per tracker the tracked frames from `counted_from` on more than 90 deg from the truth (in
+// a twin), and the default tracker's frames whose reason contains `reason`.
+struct TwinFrames {
+  int defaults = 0, other = 0, with_reason = 0;
+};
+TwinFrames CountTwinFrames(test_take::SimTake& take, int frames, int counted_from,
+                           const ProxyTrackerOptions& other, const std::string& reason) {
+  ProxyTracker a(take.model(), "proxy", take.Setup(), {});
+  ProxyTracker b(take.model(), "proxy", take.Setup(), other);
   auto flipped = [](const TrackFrameResult& r, const Rigid3& truth) {
     return r.status == TrackStatus::kTracked &&
            RotationAngle(r.camera_T_proxy.rotation, truth.rotation) > M_PI / 2;
   };
-  for (int i = 0; i < kFrames; ++i) {
+  TwinFrames count;
+  for (int i = 0; i < frames; ++i) {
     Rigid3 truth;
     const RgbdFrame frame = take.Render(i, &truth);
-    const TrackFrameResult a = held.Track(frame);
-    const TrackFrameResult b = unheld.Track(frame);
-    held_frames += a.reason.find("held") != std::string::npos;
-    held_flips += flipped(a, truth);
-    unheld_flips += flipped(b, truth);
+    const TrackFrameResult ra = a.Track(frame);
+    const TrackFrameResult rb = b.Track(frame);
+    if (i < counted_from) continue;
+    count.defaults += flipped(ra, truth);
+    count.other += flipped(rb, truth);
+    count.with_reason += ra.reason.find(reason) != std::string::npos;
   }
-  std::printf("held frames %d; frames in the twin: held %d, not held %d\n", held_frames,
-              held_flips, unheld_flips);
-  EXPECT_GE(held_frames, 1);
-  EXPECT_EQ(held_flips, 0);
-  EXPECT_GE(unheld_flips, 3);
+  std::printf("frames in the twin: defaults %d, other options %d; '%s' %d\n", count.defaults,
+              count.other, reason.c_str(), count.with_reason);
+  return count;
+}
+
+// A trusted track is held against its half-turn twin (DetectionOptions::hold_trusted).
+// configs/soldier.json's take 1, frames 0-269: at frame 254 the hand over the Soldier's head drops
+// the tracked pose's inlier share just under 0.75 and the detection verifies only the twin. With
+// the hold that frame is predicted and the track stays on the truth; without it the track switches
+// into the twin (measured with `mmh track` on the whole take: 5 frames in the twin from 254).
+TEST(ProxyTrackerTest, StructuredLightTrustedTrackIsHeldAgainstItsTwin) {
+  constexpr int kFrames = 270;
+  int take_frames = 0;
+  test_take::SimTake take = StructuredLightStoryTake("configs/soldier.json", 1, &take_frames);
+  ASSERT_GE(take_frames, kFrames);
+  ProxyTrackerOptions unheld;
+  unheld.detection.hold_trusted = false;
+  const TwinFrames count = CountTwinFrames(take, kFrames, 0, unheld, "held");
+  EXPECT_GE(count.with_reason, 1);
+  EXPECT_EQ(count.defaults, 0);
+  EXPECT_GE(count.other, 3);
+}
+
+// A re-acquisition continues the lost track's trust (DetectionOptions::reacquire_trust_frames).
+// configs/mario.json's take 2, frames 0-299: frame 263 is lost (inlier share 0.747) and the
+// re-detection on frame 264 ranks Mario's half-turn twin first; as a trusted track's detection
+// it keeps the pose near the one before the loss, as a fresh one it takes the twin (157 frames in
+// the twin on the whole take). Counted from frame 200: the first detection of this take takes the
+// twin for 10 frames either way, before any track is trusted.
+TEST(ProxyTrackerTest, StructuredLightReacquisitionKeepsTheTrust) {
+  constexpr int kFrames = 300;
+  int take_frames = 0;
+  test_take::SimTake take = StructuredLightStoryTake("configs/mario.json", 2, &take_frames);
+  ASSERT_GE(take_frames, kFrames);
+  ProxyTrackerOptions untrusted;
+  untrusted.detection.reacquire_trust_frames = 0;
+  const TwinFrames count = CountTwinFrames(take, kFrames, 200, untrusted, "");
+  EXPECT_EQ(count.defaults, 0);
+  EXPECT_GE(count.other, 20);
 }
 
 }  // namespace
