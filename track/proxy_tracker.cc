@@ -740,14 +740,13 @@ TrackFrameResult ProxyTracker::Lose(TrackFrameResult result, const std::string& 
   result.reason = reason;
   // The pose to re-acquire from (DetectionOptions::reacquire_frames): the last measured one, kept
   // for reacquire_frames lost frames.
-  if (motion_->last()) {
+  if (options_.detection.reacquire_frames > 0 && motion_->last()) {
     reacquire_pose_ = motion_->last();
     reacquire_age_ = 0;
-    reacquire_trust_ = tracked_frames_;
+    reacquire_tracked_frames_ = tracked_frames_;
   } else if (reacquire_pose_ && ++reacquire_age_ >= options_.detection.reacquire_frames) {
     reacquire_pose_.reset();
   }
-  if (options_.detection.reacquire_frames == 0) reacquire_pose_.reset();
   motion_->Reset();
   predicted_frames_ = 0;
   tracked_frames_ = 0;
@@ -1002,7 +1001,7 @@ TrackFrameResult ProxyTracker::TrackUnfiltered(const RgbdFrame& frame) {
     // ... and continues the track's trust (DetectionOptions::reacquire_trust_frames).
     if (!predicted && reacquire_pose_ &&
         reacquire_age_ < options_.detection.reacquire_trust_frames) {
-      tracked_frames_ = reacquire_trust_;
+      tracked_frames_ = reacquire_tracked_frames_;
     }
     chosen = DetectAfterLoss(frame, predicted ? predicted : reacquire_pose_, &result, &why, &held);
   }

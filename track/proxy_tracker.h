@@ -478,7 +478,7 @@ class ProxyTracker {
   // once too old.
   std::optional<Rigid3> reacquire_pose_;
   int reacquire_age_ = 0;
-  int reacquire_trust_ = 0;
+  int reacquire_tracked_frames_ = 0;
   // The exponential average of the tracked poses' scores (the slide check's reference); nullopt
   // after a loss.
   std::optional<double> recent_score_;

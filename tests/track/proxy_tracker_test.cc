@@ -375,13 +375,8 @@ TEST(ProxyTrackerTest, ALossIsReacquiredFromThePoseBeforeIt) {
   }
   ProxyTrackerOptions bad;
   bad.detection.reacquire_frames = -1;
-  try {
-    bad.Validate("tracker");
-    FAIL() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("tracker.detection.reacquire_frames"), std::string::npos)
-        << e.what();
-  }
+  const std::string error = test_util::ErrorOf([&] { bad.Validate("tracker"); });
+  EXPECT_NE(error.find("tracker.detection.reacquire_frames"), std::string::npos) << error;
 }
 
 // A story take (`config_file`: configs/soldier.json or configs/mario.json, participant 0) on
