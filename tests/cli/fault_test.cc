@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -90,7 +91,9 @@ struct Scenario {
   std::string args;               // without --out
   std::string rerun_flags;        // e.g. --resume, when the killed run wrote its config
   std::set<std::string> timings;  // files that hold timings (compared by existence only)
-  std::vector<int> kill_ms;
+  // When to kill, as fractions of the uninterrupted run's wall time (a fixed delay in ms
+  // missed every run of a 0.2 s sweep on a faster machine); above 1, after it should have ended.
+  std::vector<double> kill_at;
   bool whole_folder = true;  // the folder appears complete or not at all
 };
 
@@ -108,14 +111,18 @@ class FaultTest : public ::testing::Test {
 void KillAndRerun(const Scenario& s) {
   TempDir dir;
   const fs::path ref = dir / "ref";
+  const auto start = std::chrono::steady_clock::now();
   const auto r = RunMmh(s.args + " --quiet --out " + ref.string());
+  const double ref_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto expected = Contents(ref, s.timings);
   ASSERT_FALSE(expected.empty());
   int killed = 0;
-  for (int ms : s.kill_ms) {
+  for (size_t i = 0; i < s.kill_at.size(); ++i) {
+    const int ms = std::max(5, static_cast<int>(s.kill_at[i] * ref_ms));
     SCOPED_TRACE(s.name + " killed after " + std::to_string(ms) + " ms");
-    const fs::path out = dir / ("out_" + std::to_string(ms));
+    const fs::path out = dir / ("out_" + std::to_string(i));
     killed +=
         KillAfter(Split(s.args + " --quiet --out " + out.string()), std::chrono::milliseconds(ms));
     if (s.whole_folder && fs::exists(out)) {
@@ -143,7 +150,7 @@ TEST_F(FaultTest, RenderKilledLeavesNothingPartialAndARerunGivesTheSameBytes) {
                 "render --set render.frames=45 --threads 2",
                 "",
                 {"run.json", "render_summary.json"},
-                {30, 300, 900, 2000}});
+                {0.015, 0.15, 0.45, 1.0}});
 }
 
 // The last kill may come after the run finished: `--resume` of a complete folder must give the
@@ -154,7 +161,7 @@ TEST_F(FaultTest, RunKilledResumesToTheSameBytes) {
                     "/configs/soldier.json --set render.frames=70 --threads 2",
                 "--resume",
                 {"run.json", "timings.csv"},
-                {200, 1500, 4000},
+                {0.13, 1.0, 2.6},
                 /*whole_folder=*/false});
 }
 
@@ -165,7 +172,7 @@ TEST_F(FaultTest, StudyKilledLeavesNothingPartialAndARerunGivesTheSameBytes) {
                     "--threads 2",
                 "",
                 {"run.json"},
-                {100, 400, 1200}});
+                {0.15, 0.6, 1.8}});
 }
 
 // A sweep continues when run again (cells whose status says done are skipped): killed while its
@@ -189,7 +196,7 @@ TEST_F(FaultTest, SweepKilledContinuesToTheSameBytes) {
                 "sweep --jobs 2 --threads 2 --spec " + spec.string(),
                 "",
                 {"run.json", "provenance.json"},
-                {150, 600, 1500},
+                {0.1, 0.4, 0.75},
                 /*whole_folder=*/false});
 }
 
