@@ -96,10 +96,10 @@ struct MissingDataModel {
 };
 
 struct KinectSensorOptions {
-  // Statistical (default, fast) or structured light (structured_light below; the axial, lateral
-  // and missing models then do not apply, except missing.projector_shadow and
-  // missing.ir_camera_occlusion).
-  SensorMode mode = SensorMode::kStatistical;
+  // Structured light (default: the speckle image and block matching, structured_light below) or
+  // statistical (the fast per-pixel model; the axial, lateral and missing models apply only to it,
+  // except missing.projector_shadow and missing.ir_camera_occlusion, which apply to both).
+  SensorMode mode = SensorMode::kStructuredLight;
   // Intrinsics of the delivered images: with registered depth both depth and colour are in the
   // colour camera's image (ROS defaults 525 / 319.5 / 239.5).
   PinholeIntrinsics intrinsics;

@@ -3,8 +3,8 @@
 //
 // Table frame (docs/notation.md): z up, origin at the centre of the play area on the table top,
 // x to the right as seen by the camera, y away from the camera. The camera stands above and in
-// front of the table, at about (0, -0.9, 0.75) looking at the origin; the animator sits behind the
-// table (+y) facing it.
+// front of the table, by default at (0, -0.65, 0.55), 0.85 m from the origin it looks at; the
+// animator sits behind the table (+y) facing it.
 #pragma once
 
 #include <Eigen/Core>

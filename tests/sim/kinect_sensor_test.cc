@@ -1,4 +1,5 @@
-// The synthetic Kinect against analytic geometry and its own noise model, with p-values.
+// The synthetic Kinect's statistical mode against analytic geometry and its own noise model, with
+// p-values (structured light, the default mode: structured_light_test.cc).
 #include "sim/kinect_sensor.h"
 
 #include <gmock/gmock.h>
@@ -38,8 +39,15 @@ Rigid3 FacingCamera(double z, const Eigen::Vector3d& normal = Eigen::Vector3d::U
   return Rigid3(q, Eigen::Vector3d(0, 0, z));
 }
 
-KinectSensorOptions Exact() {
+// The statistical mode's options (the default mode is structured light).
+KinectSensorOptions Statistical() {
   KinectSensorOptions options;
+  options.mode = SensorMode::kStatistical;
+  return options;
+}
+
+KinectSensorOptions Exact() {
+  KinectSensorOptions options = Statistical();
   options.noise = false;
   options.quantise = false;
   return options;
@@ -166,7 +174,7 @@ TEST(KinectSensor, EveryDepthLiesOnTheDisparityLattice) {
   const Eigen::Vector3d n = Eigen::Vector3d(0.2, 0.5, -1.0).normalized();
   scene.AddStatic("wall", Quad(20, 20), FacingCamera(1.8, n));
   scene.Commit();
-  KinectSensorOptions options;  // full noise
+  KinectSensorOptions options = Statistical();  // full noise
   KinectSensor sensor(options, &scene, Rigid3::Identity());
   const RgbdFrame frame = sensor.Render(3);
   const double lattice = options.calibration.lattice_constant();
@@ -196,7 +204,7 @@ TEST(KinectSensor, FrontoParallelNoiseHasTheModelledSigmaAt06To3m) {
     RayScene scene;
     scene.AddStatic("wall", Quad(30, 30), FacingCamera(z, -Eigen::Vector3d::UnitZ()));
     scene.Commit();
-    KinectSensorOptions options;
+    KinectSensorOptions options = Statistical();
     options.quantise = false;  // sigma_z alone; the lattice is tested separately
     options.seed = 11;
     KinectSensor sensor(options, &scene, Rigid3::Identity());
@@ -261,7 +269,7 @@ TEST(KinectSensor, NoisyMissingPixelsConcentrateBesideEdgesOnTheProjectorSide) {
   const uint32_t box = scene.AddMoving("box", Box(0.3, 0.3, 0.02));
   scene.SetPose(box, Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, 1.01)));
   scene.Commit();
-  KinectSensorOptions options;
+  KinectSensorOptions options = Statistical();
   KinectSensor sensor(options, &scene, Rigid3::Identity());
   const RgbdFrame frame = sensor.Render(5);
   const PinholeIntrinsics& k = frame.depth_intrinsics;
@@ -305,7 +313,7 @@ TEST(KinectSensor, IncrementalFramesEqualFullRerenders) {
     for (const bool vector_kernels : {true, false}) {
       SCOPED_TRACE(testing::Message() << "registered " << registered << ", vector kernels "
                                       << KinectSensor::SetVectorKernels(vector_kernels));
-      KinectSensorOptions options;
+      KinectSensorOptions options = Statistical();
       options.registered = registered;
       KinectSensor incremental(options, &scene, Rigid3::Identity());
       KinectSensor full(options, &scene, Rigid3::Identity());
@@ -346,7 +354,7 @@ TEST(KinectSensor, IncrementalShadowsOfObjectsMovingEitherWay) {
   for (const bool vector_kernels : {true, false}) {
     SCOPED_TRACE(testing::Message()
                  << "vector kernels " << KinectSensor::SetVectorKernels(vector_kernels));
-    KinectSensorOptions options;
+    KinectSensorOptions options = Statistical();
     KinectSensor incremental(options, &scene, Rigid3::Identity());
     KinectSensor full(options, &scene, Rigid3::Identity());
     for (int i = 0; i < 10; ++i) {
@@ -411,7 +419,7 @@ TEST(KinectSensor, FramesAreIndependentOfTheThreadCountAndFollowTheSeed) {
   scene.SetPose(a, Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY())),
                           Eigen::Vector3d(0.02, 0.01, 0.9)));
   scene.Commit();
-  KinectSensorOptions options;
+  KinectSensorOptions options = Statistical();
   RgbdFrame one, two, other_seed;
   {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
@@ -451,7 +459,7 @@ TEST(KinectSensor, VectorAndPortableKernelsGiveTheSameBytes) {
         std::tuple{false, 2.5, SensorMode::kStatistical},
         std::tuple{true, 12.0, SensorMode::kStatistical},
         std::tuple{true, 1.5, SensorMode::kStructuredLight}}) {
-    KinectSensorOptions options;
+    KinectSensorOptions options = Statistical();
     options.mode = mode;
     options.quantise = quantise;
     options.color.read_noise = read_noise;
@@ -518,7 +526,7 @@ TEST(KinectSensor, DepthNoiseIsNormalWithTheModelledSigma) {
   RayScene scene;
   scene.AddStatic("wall", Quad(30, 30), FacingCamera(z, -Eigen::Vector3d::UnitZ()));
   scene.Commit();
-  KinectSensorOptions options;
+  KinectSensorOptions options = Statistical();
   options.quantise = false;
   options.seed = 5;
   KinectSensor sensor(options, &scene, Rigid3::Identity());
@@ -547,7 +555,7 @@ std::pair<RgbdFrame, RgbdFrame> NoisyAndCleanWall(int albedo, KinectSensorOption
 }
 
 TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
-  KinectSensorOptions options;
+  KinectSensorOptions options = Statistical();
   options.seed = 9;
   const auto [x, clean] = NoisyAndCleanWall(170, options);
   const int value = clean.rgb[0];
@@ -575,7 +583,7 @@ TEST(KinectSensor, ColorNoiseIsNormalWithTheModelledSigmaAndUncorrelated) {
 // Near black and near white the noisy bytes clamp: the bins 0 and 255 hold the whole tails.
 TEST(KinectSensor, ColorNoiseClampsToTheByteRange) {
   for (int albedo : {2, 252}) {
-    KinectSensorOptions options;
+    KinectSensorOptions options = Statistical();
     options.seed = 21;
     // Linear light factor about 1: the albedo's own (dark or bright) value.
     options.color.ambient = 1.0;
@@ -606,7 +614,7 @@ TEST(KinectSensor, FrameParallelRenderingGivesTheSequentialFrames) {
                           Eigen::Vector3d(-0.2 + 0.05 * i, 0.01 * i, 1.0)));
     scene->Commit();
   };
-  KinectSensorOptions options;
+  KinectSensorOptions options = Statistical();
   for (RenderMode mode : {RenderMode::kIncremental, RenderMode::kFull}) {
     RayScene reference_scene;
     const uint32_t reference_object = make_scene(&reference_scene);
@@ -653,7 +661,7 @@ TEST(KinectSensor, NonsenseOptionsAreRejectedNamingTheField) {
   RayScene scene;
   scene.AddStatic("wall", Quad(10, 10), FacingCamera(1.0, -Eigen::Vector3d::UnitZ()));
   scene.Commit();
-  KinectSensorOptions options;
+  KinectSensorOptions options = Statistical();
   options.intrinsics.fx = -5;
   try {
     KinectSensor sensor(options, &scene, Rigid3::Identity());
@@ -662,10 +670,10 @@ TEST(KinectSensor, NonsenseOptionsAreRejectedNamingTheField) {
     EXPECT_THAT(e.what(), HasSubstr("sensor.intrinsics.fx"));
     EXPECT_THAT(e.what(), HasSubstr("-5"));
   }
-  options = KinectSensorOptions();
+  options = Statistical();
   options.max_depth = 0.3;
   EXPECT_THROW(KinectSensor(options, &scene, Rigid3::Identity()), InputError);
-  options = KinectSensorOptions();
+  options = Statistical();
   options.missing.edge_probability = 1.5;
   EXPECT_THROW(KinectSensor(options, &scene, Rigid3::Identity()), InputError);
 }

@@ -89,7 +89,7 @@ TEST(ProxyTrackerTest, OtherWalksPooled) {
   int frames = 0, successes = 0, longest = 0;
   std::vector<double> rotations, translations;
   for (int seed = 2; seed <= 6; ++seed) {
-    sim::RenderConfig config;
+    sim::RenderConfig config = test_take::StatisticalConfig();
     config.sensor.seed = seed;
     config.motion.round_period = 4.0 + seed;
     config.motion.yaw_swing = 0.1 * seed;
@@ -123,7 +123,7 @@ Rigid3 FastTableTProxy(double t) {
 }
 
 TEST(ProxyTrackerTest, FastTumblingWithHand) {
-  test_take::SimTake take({}, FastTableTProxy);
+  test_take::SimTake take(test_take::StatisticalConfig(), FastTableTProxy);
   const TakeResult result = TrackTake(take, 200);
   EXPECT_LE(result.summary.median_rotation_deg, 1.0);
   EXPECT_LE(result.summary.median_translation, 0.002);
@@ -148,7 +148,7 @@ Rigid3 JumpingTableTProxy(double t) {
 }
 
 TEST(ProxyTrackerTest, LossesAreDetectedAndRecovered) {
-  test_take::SimTake take({}, JumpingTableTProxy);
+  test_take::SimTake take(test_take::StatisticalConfig(), JumpingTableTProxy);
   const TakeResult result = TrackTake(take, 200);  // jumps at frames 60, 120, 180
   EXPECT_TRUE(result.summary.all_recovered);
   EXPECT_LE(result.summary.longest_failure, 15);
@@ -314,7 +314,8 @@ TEST(ProxyTrackerTest, MarioStoryTakeKeepsTheTruthOverItsTwin) {
 // "Options for correlated depth errors"), so only the lost frames are asserted.
 TEST(ProxyTrackerTest, StructuredLightWindowCheckKeepsTheTrack) {
   constexpr int kFrames = 60;
-  sim::RenderConfig config;
+  // (The camera of the statistical frames, 1.17 m from the play area, where it was measured.)
+  sim::RenderConfig config = test_take::StatisticalConfig();
   config.sensor.mode = sim::SensorMode::kStructuredLight;
   auto lost = [](const TakeResult& result) {
     return std::count_if(result.frames.begin(), result.frames.end(),
@@ -395,7 +396,8 @@ test_take::SimTake StructuredLightStoryTake(const std::string& config_file, int 
   std::ofstream(file) << config.dump();
   return test_take::SoldierStorySession(MMH_SOURCE_DIR, 0, take_index,
                                         sim::RenderSession::kRecording, take_frames,
-                                        std::filesystem::relative(file, MMH_SOURCE_DIR).string());
+                                        std::filesystem::relative(file, MMH_SOURCE_DIR).string(),
+                                        /*statistical=*/false);
 }
 
 // Two trackers, with the default options and with `other`, see the same first `frames` frames of

@@ -29,8 +29,10 @@ const fs::path& RenderedTake() {
   static TempDir dir;  // removed at exit
   static const fs::path take = [] {
     const fs::path out = dir / "take";
-    const auto result = RunMmh("render --quiet --out " + out.string() +
-                               " --set render.frames=60 --set render.fakenect=true");
+    // (On structured-light frames, the default, the first detection comes on the third frame.)
+    const auto result =
+        RunMmh("render --quiet --out " + out.string() + " --set render.frames=60 " +
+               "--set render.fakenect=true" + std::string(test_util::kStatisticalFrames));
     EXPECT_EQ(result.exit_code, 0) << result.output;
     return out;
   }();
