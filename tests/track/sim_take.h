@@ -105,11 +105,17 @@ inline SimTake SoldierStorySession(const std::string& source, int animator, int 
   sim::RenderConfig config = sim::RenderConfig::FromConfig(file);
   if (statistical) UseStatisticalFrames(&config);
   people::PeopleConfig people = people::PeopleConfig::FromConfig(file);
-  // The people the tests' takes and their events were measured with
+  // The people the tests' takes and their events were measured with, unless the config sets them
   // (configs/people/calibrated_2026_11_25.json): the recalibration of 2026-11-29 changed the
   // learning and the annotators' dead band, and with them every performed take.
-  people.population.learning_mean = 0.0546;
-  people.population.move_threshold_mean = 0.984;
+  const nlohmann::json& root = file.root();
+  const bool has_population = root.contains("population") && root["population"].is_object();
+  if (!has_population || !root["population"].contains("learning_mean")) {
+    people.population.learning_mean = 0.0546;
+  }
+  if (!has_population || !root["population"].contains("move_threshold_mean")) {
+    people.population.move_threshold_mean = 0.984;
+  }
   people.scenario.story = source + "/" + people.scenario.story;
   people.scenario.animator = animator;
   config.render.take = take;
