@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <tbb/parallel_for.h>
 
 #include "core/error.h"
 #include "core/options.h"
@@ -351,6 +352,10 @@ nlohmann::json ErrorModelEstimate::ToJson() const {
           {"lost_frames", lost_frames},
           {"flip_episodes", flip_episodes},
           {"spike_episodes", spike_episodes},
+          {"moments", mmh::ToJson(moments)},
+          {"core_excursion_rate", core_excursion_rate},
+          {"spike_visibility", spike_visibility},
+          {"simulation_iterations", simulation_iterations},
           {"loss_episodes", loss_episodes},
           {"slider_frames", slider_frames},
           {"slider_missed", slider_missed},
@@ -564,6 +569,217 @@ void FitSlider(const std::vector<ReadingObservation>& readings, ErrorModelEstima
   }
 }
 
+// ---- The correction by simulation (EstimateErrorModel's header) -----------------------------
+
+// The parts of the model the correction fits, pooled over the view conditions, and the same
+// quantities as the moment fit measures them.
+struct PooledSpikes {
+  double rotation_sd = 0.0, translation_sd = 0.0, correlation = 0.0;
+  double rate = 0.0, mean_frames = 1.0;  // spike episodes per free frame, mean length
+  double spike_rotation_sd = 0.0, spike_translation_sd = 0.0;
+};
+
+// The moments of `model`'s frames: `frames` frames of the six AR(1) axes with spike
+// episodes drawn as SimulateTracking draws them (one view condition), split at the thresholds as
+// AddTracking splits them and fitted as FitPoseErrors fits them. Fixed seeds: the same random
+// numbers in every call, so the result is a deterministic function of the model.
+PooledSpikes SimulatedMoments(const PooledSpikes& model, const GrossThresholds& gross,
+                              int frames = 1 << 18) {
+  constexpr std::uint64_t kSeed = 0x6d6f6d656e7473;  // "moments"
+  people::Random core_random(people::DeriveSeed(kSeed, {kPoseStream}));
+  people::Random episode_random(people::DeriveSeed(kSeed, {kSpikeStream}));
+  people::Random shape_random(people::DeriveSeed(kSeed, {kSpikeShapeStream}));
+  std::array<Ar1, 6> axes = {
+      Ar1(model.rotation_sd, model.correlation),    Ar1(model.rotation_sd, model.correlation),
+      Ar1(model.rotation_sd, model.correlation),    Ar1(model.translation_sd, model.correlation),
+      Ar1(model.translation_sd, model.correlation), Ar1(model.translation_sd, model.correlation)};
+  std::array<double, 2> squares = {0, 0}, lag_products = {0, 0}, lag_squares = {0, 0};
+  std::array<double, 2> spike_squares = {0, 0};
+  std::int64_t inliers = 0, starts = 0, at_risk = 0, spike_frames = 0, ends = 0;
+  std::array<double, 6> spike{}, previous{};
+  bool in_episode = false, previous_inlier = false, previous_spike = false;
+  for (int t = 0; t < frames; ++t) {
+    // The episode chain first (DrawEpisodes), then the frame's error (SimulateTracking).
+    bool spiking = in_episode;
+    if (!in_episode && episode_random.Bernoulli(model.rate)) {
+      spiking = in_episode = true;
+      for (int k = 0; k < 3; ++k) spike[k] = shape_random.Normal(0, model.spike_rotation_sd);
+      for (int k = 3; k < 6; ++k) spike[k] = shape_random.Normal(0, model.spike_translation_sd);
+    }
+    if (in_episode && episode_random.Bernoulli(1.0 / model.mean_frames)) in_episode = false;
+    std::array<double, 6> x;
+    for (int k = 0; k < 6; ++k) x[k] = axes[k].Next(core_random) + (spiking ? spike[k] : 0.0);
+    const double angle = std::hypot(x[0], x[1], x[2]);
+    const bool gross_frame =
+        angle > gross.rotation_rad || std::hypot(x[3], x[4], x[5]) > gross.translation_m;
+    // A turn past 90° would count as a flip: neither a spike nor free (CountRuns' exclusion).
+    const bool flip_like = gross_frame && angle > kPi / 2;
+    const bool spike_frame = gross_frame && !flip_like;
+    if (spike_frame) {
+      ++spike_frames;
+      if (!previous_spike) ++starts, ++at_risk;
+      for (int k = 0; k < 6; ++k) spike_squares[k / 3] += x[k] * x[k];
+    } else if (!flip_like) {
+      ++at_risk;
+    }
+    if (previous_spike && !spike_frame) ++ends;
+    if (!gross_frame) {
+      ++inliers;
+      for (int k = 0; k < 6; ++k) squares[k / 3] += x[k] * x[k];
+      if (previous_inlier) {
+        for (int k = 0; k < 6; ++k) {
+          lag_products[k / 3] += previous[k] * x[k];
+          lag_squares[k / 3] += 0.5 * (previous[k] * previous[k] + x[k] * x[k]);
+        }
+      }
+    }
+    previous = x;
+    previous_inlier = !gross_frame;
+    previous_spike = spike_frame;
+  }
+  PooledSpikes seen = model;
+  if (inliers > 0) {
+    seen.rotation_sd = std::sqrt(squares[0] / (3.0 * static_cast<double>(inliers)));
+    seen.translation_sd = std::sqrt(squares[1] / (3.0 * static_cast<double>(inliers)));
+  }
+  double numerator = 0, denominator = 0;
+  const std::array<double, 2> sds = {seen.rotation_sd, seen.translation_sd};
+  for (int type = 0; type < 2; ++type) {
+    if (sds[type] <= 0 || lag_squares[type] <= 0) continue;
+    numerator += lag_products[type] / (sds[type] * sds[type]);
+    denominator += lag_squares[type] / (sds[type] * sds[type]);
+  }
+  if (denominator > 0) seen.correlation = numerator / denominator;
+  seen.rate = at_risk > 0 ? static_cast<double>(starts) / static_cast<double>(at_risk) : 0.0;
+  if (ends > 0) seen.mean_frames = static_cast<double>(spike_frames) / static_cast<double>(ends);
+  if (spike_frames > 0) {
+    seen.spike_rotation_sd = std::sqrt(spike_squares[0] / (3.0 * static_cast<double>(spike_frames)));
+    seen.spike_translation_sd =
+        std::sqrt(spike_squares[1] / (3.0 * static_cast<double>(spike_frames)));
+  }
+  return seen;
+}
+
+// The model whose simulated moments are `measured`: a fixed-point iteration from `start`, sds
+// scaled by measured / simulated, the correlation, rate and length moved by measured − simulated
+// (rate ≥ 0, length ≥ 1), until nothing moves by more than 1e-3 of its measured value (at most
+// max_iterations: the simulated moments are step functions of the rate and length, so the last
+// steps need not settle; the simulation's own sampling error is larger). What moves: `Fitted`.
+enum class Fitted { kCore, kCoreAndSpikes, kEpisodes };
+PooledSpikes FitToMoments(const PooledSpikes& measured, const PooledSpikes& start, Fitted fitted,
+                          const GrossThresholds& gross, int frames, int max_iterations,
+                          int* iterations) {
+  PooledSpikes model = start;
+  for (*iterations = 1;; ++*iterations) {
+    const PooledSpikes seen = SimulatedMoments(model, gross, frames);
+    double change = 0.0;
+    const auto scale = [&](double* value, double want, double got) {
+      if (!(want > 0 && got > 0)) return;
+      const double next = *value * want / got;
+      change = std::max(change, std::abs(next - *value) / want);
+      *value = next;
+    };
+    const auto shift = [&](double* value, double want, double got, double low, double high,
+                           double unit) {
+      const double next = std::clamp(*value + want - got, low, high);
+      change = std::max(change, std::abs(next - *value) / unit);
+      *value = next;
+    };
+    if (fitted != Fitted::kEpisodes) {
+      scale(&model.rotation_sd, measured.rotation_sd, seen.rotation_sd);
+      scale(&model.translation_sd, measured.translation_sd, seen.translation_sd);
+      shift(&model.correlation, measured.correlation, seen.correlation, 0.0, 0.999, 1.0);
+    }
+    if (fitted == Fitted::kCoreAndSpikes) {
+      scale(&model.spike_rotation_sd, measured.spike_rotation_sd, seen.spike_rotation_sd);
+      scale(&model.spike_translation_sd, measured.spike_translation_sd,
+            seen.spike_translation_sd);
+    }
+    if (fitted != Fitted::kCore) {
+      shift(&model.rate, measured.rate, seen.rate, 0.0, 1.0, std::max(measured.rate, 1e-3));
+      shift(&model.mean_frames, measured.mean_frames, seen.mean_frames, 1.0, 1e6,
+            measured.mean_frames);
+    }
+    if (change <= 1e-3 || *iterations == max_iterations) break;
+  }
+  return model;
+}
+
+// Applies the correction to the moment fit in `estimate` (its options hold the moments).
+void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross,
+                         ErrorModelEstimate* estimate) {
+  ErrorModelOptions& fit = estimate->options;
+  const Runs& runs = sums.spike_runs;
+  const std::int64_t at_risk = runs.Total(runs.at_risk), ends = runs.Total(runs.ends);
+  if (estimate->inlier_frames == 0 || at_risk == 0) return;
+  PooledSpikes measured;
+  measured.rotation_sd = fit.rotation_sd;
+  measured.translation_sd = fit.translation_sd;
+  measured.correlation = fit.correlation;
+  measured.rate = static_cast<double>(runs.Total(runs.starts)) / static_cast<double>(at_risk);
+  measured.mean_frames = ends > 0 ? static_cast<double>(runs.Total(runs.frames)) /
+                                        static_cast<double>(ends)
+                                  : 1.0;
+  measured.spike_rotation_sd = fit.spike_rotation_sd;
+  measured.spike_translation_sd = fit.spike_translation_sd;
+  // The core alone first: when the spikes' starts are within 2 Poisson standard errors of its
+  // own excursions' there are no spikes to fit (their size and visibility would not be
+  // identified, and a condition's sampling error would be read as spikes).
+  PooledSpikes core_start = measured;
+  core_start.rate = 0.0;
+  int core_iterations = 0;
+  const PooledSpikes core =
+      FitToMoments(measured, core_start, Fitted::kCore, gross, 1 << 18, 25, &core_iterations);
+  const double core_rate = SimulatedMoments(core, gross).rate;
+  const double expected_starts = core_rate * static_cast<double>(at_risk);
+  const bool spikes = static_cast<double>(runs.Total(runs.starts)) >
+                      expected_starts + 2.0 * std::sqrt(expected_starts);
+  PooledSpikes model = core;
+  if (spikes) {
+    model = FitToMoments(measured, measured, Fitted::kCoreAndSpikes, gross, 1 << 18, 25,
+                         &estimate->simulation_iterations);
+    PooledSpikes core_only = model;
+    core_only.rate = 0.0;
+    estimate->core_excursion_rate = SimulatedMoments(core_only, gross).rate;
+    estimate->spike_visibility =
+        std::max(0.0, measured.rate - estimate->core_excursion_rate) / model.rate;
+  } else {
+    estimate->simulation_iterations = core_iterations;
+    estimate->core_excursion_rate = core_rate;
+  }
+  fit.rotation_sd = model.rotation_sd;
+  fit.translation_sd = model.translation_sd;
+  fit.correlation = model.correlation;
+  if (spikes) {
+    fit.spike_rotation_sd = model.spike_rotation_sd;
+    fit.spike_translation_sd = model.spike_translation_sd;
+  }
+  // Per view condition with data: the rate and length whose simulated moments (with the pooled
+  // core and sizes) are the condition's; the relation is not linear (an episode that starts on
+  // the frame after another ends merges with it into one run, more often the higher the rate).
+  tbb::parallel_for(0, kViewConditions, [&](int c) {
+    EpisodeRates& r = fit.view.condition[c];
+    if (runs.at_risk[c] == 0) return;
+    if (!spikes || model.rate == 0.0) {
+      r.spike_rate = 0.0;
+      return;
+    }
+    PooledSpikes condition = model;
+    condition.rate = r.spike_rate;
+    condition.mean_frames = runs.ends[c] > 0 ? r.spike_mean_frames : measured.mean_frames;
+    PooledSpikes start = model;
+    start.rate = std::max(0.0, r.spike_rate - estimate->core_excursion_rate) /
+                 std::max(estimate->spike_visibility, 1e-3);
+    start.mean_frames =
+        std::max(1.0, condition.mean_frames * model.mean_frames / measured.mean_frames);
+    int iterations = 0;
+    const PooledSpikes fitted =
+        FitToMoments(condition, start, Fitted::kEpisodes, gross, 1 << 16, 15, &iterations);
+    r.spike_rate = fitted.rate;
+    if (runs.ends[c] > 0) r.spike_mean_frames = fitted.mean_frames;
+  });
+}
+
 }  // namespace
 
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
@@ -578,6 +794,8 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
     AddTracking(tracking[i], i, prior, gross, &sums, &estimate);
   }
   FitPoseErrors(sums, &estimate);
+  estimate.moments = estimate.options;
+  CorrectBySimulation(sums, gross, &estimate);
   FitSlider(readings, &estimate);
   return estimate;
 }

@@ -183,6 +183,13 @@ struct ReadingObservation {
 
 struct ErrorModelEstimate {
   ErrorModelOptions options;  // the fitted model (fields without data keep `prior`'s values)
+  // The moments as measured, before the correction by simulation (see EstimateErrorModel).
+  ErrorModelOptions moments;
+  // The correction: the fitted core's own excursion starts per frame at risk, the share of the
+  // fitted spike episodes that the moments see, and the iterations it took.
+  double core_excursion_rate = 0.0;
+  double spike_visibility = 1.0;
+  int simulation_iterations = 0;
   std::int64_t frames = 0;    // tracked frames observed
   std::array<std::int64_t, kViewConditions> condition_frames{};  // of them, per view condition
   std::int64_t inlier_frames = 0;
@@ -213,8 +220,18 @@ struct ErrorModelEstimate {
 // rate = episodes starting in it / its frames free at the time (not in an episode of that kind or
 // an earlier one), the mean length = its episode frames / the episodes ending after one of them
 // (the Markov chain's maximum-likelihood hazards); a condition without frames keeps `prior`'s. The
-// slider's bias, sd and lag-one correlation over found frames, miss share = missed / frames. The
-// maximum-likelihood estimates of the model for a large sample.
+// slider's bias, sd and lag-one correlation over found frames, miss share = missed / frames.
+//
+// These moments (`moments`) are biased wherever the thresholds cut the model's own processes: the
+// core noise goes past them by itself (with σ = 0.026 rad on about 1 % of frames), which they
+// count as spikes; spikes smaller than the thresholds count as core noise and are missed as
+// spikes; the core's RMS is taken over frames cut at the thresholds. So the core (σ, ρ), the
+// spikes' sizes and their pooled rate and mean length are corrected by simulation (indirect
+// inference): they are the model whose simulated frames (the core and spikes of SimulateTracking,
+// one view condition, from fixed seeds) give the measured pooled moments. The rate per view
+// condition is then (measured rate − the core's own excursion rate) / the spikes' visibility
+// (the share of spike episodes the moments see), the length the measured one times the pooled
+// correction. Losses, flips and the slider keep their moments.
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
                                       const std::vector<ReadingObservation>& readings,
                                       const ErrorModelOptions& prior = {},

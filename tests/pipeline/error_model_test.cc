@@ -319,12 +319,8 @@ TEST(ErrorModelTest, EpisodesFollowTheViewConditionAndTheEstimatorRecoversThem) 
   options.view.condition[kLying].spike_rate = 0.03;
   options.spike_rotation_sd = 0.4;
   options.spike_translation_sd = 0.02;
-  // The core noise of statistical frames (0.64 deg, 0.73 mm): the estimator counts every run
-  // beyond 5 deg or 1 cm as a spike, and with the core noise of structured-light frames (1.5 deg,
-  // 1.56 mm, the defaults since 2026-11-29) the core alone goes past that on about 1 % of frames,
-  // which this test of the episode hazards would count against them.
-  options.rotation_sd = 0.0112;
-  options.translation_sd = 0.00073;
+  // The core noise is the default (structured-light frames: 1.5 deg, 1.56 mm per axis), which by
+  // itself goes past 5 deg on about 1 % of frames: the estimator must not count that as spikes.
   const int frames = 30000;
   std::vector<Trajectory> truths;
   std::vector<SimulatedTracking> sims;
@@ -361,7 +357,10 @@ TEST(ErrorModelTest, EpisodesFollowTheViewConditionAndTheEstimatorRecoversThem) 
     ASSERT_GT(n, 3000) << ViewConditionName(c);
     EXPECT_NEAR(fit.flip_rate, truth.flip_rate, 4 * std::sqrt(truth.flip_rate / (0.7 * n)))
         << ViewConditionName(c);
-    EXPECT_NEAR(fit.spike_rate, truth.spike_rate, 4 * std::sqrt(truth.spike_rate / (0.7 * n)))
+    // The spikes' count includes the core's own excursions, which are subtracted in expectation
+    // but whose sampling error stays.
+    EXPECT_NEAR(fit.spike_rate, truth.spike_rate,
+                4 * std::sqrt((truth.spike_rate + estimate.core_excursion_rate) / (0.7 * n)))
         << ViewConditionName(c);
     EXPECT_NEAR(fit.loss_rate, truth.loss_rate, 4 * std::sqrt(truth.loss_rate / (0.7 * n)))
         << ViewConditionName(c);
@@ -370,6 +369,102 @@ TEST(ErrorModelTest, EpisodesFollowTheViewConditionAndTheEstimatorRecoversThem) 
   const auto& lying = estimate.options.view.condition[kLying];
   EXPECT_NEAR(lying.flip_mean_frames, 30, 4 * 30 / std::sqrt(0.01 * 0.5 * 20000));
   EXPECT_NEAR(lying.spike_mean_frames, 2, 0.4);
+}
+
+// The core process alone, with an sd that crosses the gross thresholds on a few per cent of frames
+// and no spikes: by moments its excursions are spikes and its σ the RMS of the frames within the
+// thresholds (computed here from the definitions); corrected by simulation, the spike rate is 0
+// within sampling error and σ and ρ are the process's.
+TEST(ErrorModelTest, TheCoresOwnExcursionsAreNotSpikes) {
+  ErrorModelOptions options;
+  options.view = ViewRates::Uniform({});  // no losses, flips or spikes
+  options.rotation_sd = 0.035;            // 2 deg per axis: about 4 % of frames beyond 5 deg
+  options.translation_sd = 0.002;
+  options.correlation = 0.5;
+  const int frames = 40000;
+  std::vector<Trajectory> truths;
+  std::vector<SimulatedTracking> sims;
+  std::vector<TrackingObservation> tracking;
+  for (int take = 0; take < 3; ++take) truths.push_back(Walk(frames));
+  for (int take = 0; take < 3; ++take) {
+    sims.push_back(SimulateTracking(truths[take], options, 500 + take, kCamera));
+  }
+  // The truncated moments, computed here from the definitions.
+  double squares = 0, inliers = 0;
+  std::int64_t beyond = 0;
+  for (int take = 0; take < 3; ++take) {
+    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status, kCamera});
+    for (int t = 0; t < frames; ++t) {
+      const auto e = Error(truths[take].poses[t], sims[take].tracked.poses[t]);
+      if (std::hypot(e[0], e[1], e[2]) > 5 * kPi / 180 || std::hypot(e[3], e[4], e[5]) > 0.01) {
+        ++beyond;
+        continue;
+      }
+      squares += e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+      inliers += 3;
+    }
+  }
+  const double truncated_rms = std::sqrt(squares / inliers);
+  const ErrorModelEstimate estimate = EstimateErrorModel(tracking, {}, options);
+  EXPECT_EQ(estimate.spike_frames, beyond);
+  ASSERT_GT(estimate.spike_episodes, 2000);  // what the moments count as spikes
+  EXPECT_NEAR(estimate.moments.rotation_sd, truncated_rms, 1e-12 * truncated_rms);
+  const double n = 3.0 * frames;
+  for (int c = 0; c < kViewConditions; ++c) {
+    const EpisodeRates& fit = estimate.options.view.condition[c];
+    const double m = double(estimate.condition_frames[c]);
+    if (m == 0) continue;
+    // The starts' Poisson sd over this condition's frames, as a rate.
+    EXPECT_LT(fit.spike_rate, 4 * std::sqrt(0.03 / m) + 0.002) << ViewConditionName(c);
+  }
+  // The truncated RMS understates σ; the fit undoes it.
+  EXPECT_LT(truncated_rms, 0.97 * options.rotation_sd);
+  const double sd_tolerance = 4 * SdRelativeError(n, options.correlation);
+  EXPECT_NEAR(estimate.options.rotation_sd, options.rotation_sd,
+              sd_tolerance * options.rotation_sd);
+  EXPECT_NEAR(estimate.options.translation_sd, options.translation_sd,
+              sd_tolerance * options.translation_sd);
+  EXPECT_NEAR(estimate.options.correlation, options.correlation, 0.02);
+}
+
+// The committed defaults are a fixed point of simulate-then-estimate: fast-mode takes drawn from
+// them give back their core noise, their spikes' sizes and their spike hazards pooled over the
+// frames. (By moments alone, 2026-11-29: 5 % fewer spike starts, the translation sd 6 % and the
+// spikes' rotation sd 10 % too large.)
+TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
+  const ErrorModelOptions options;
+  const int frames = 30000;
+  std::vector<Trajectory> truths;
+  std::vector<SimulatedTracking> sims;
+  std::vector<TrackingObservation> tracking;
+  for (int take = 0; take < 4; ++take) truths.push_back(Walk(frames));
+  for (int take = 0; take < 4; ++take) {
+    sims.push_back(SimulateTracking(truths[take], options, 700 + take, kCamera));
+  }
+  for (int take = 0; take < 4; ++take) {
+    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status, kCamera});
+  }
+  const ErrorModelEstimate estimate = EstimateErrorModel(tracking, {}, options);
+  const ErrorModelOptions& fit = estimate.options;
+  const double n = 3.0 * estimate.inlier_frames;
+  const double sd_tolerance = 4 * SdRelativeError(n, options.correlation);
+  EXPECT_NEAR(fit.rotation_sd, options.rotation_sd, sd_tolerance * options.rotation_sd);
+  EXPECT_NEAR(fit.translation_sd, options.translation_sd, sd_tolerance * options.translation_sd);
+  EXPECT_NEAR(fit.correlation, options.correlation, 0.02);
+  // Pooled over the frames: Σ_c rate_c · at-risk frames is the expected number of starts.
+  double expected = 0, fitted = 0;
+  for (int c = 0; c < kViewConditions; ++c) {
+    const double m = double(estimate.condition_frames[c]);
+    expected += options.view.condition[c].spike_rate * m;
+    fitted += fit.view.condition[c].spike_rate * m;
+  }
+  EXPECT_NEAR(fitted, expected, 4 * std::sqrt(expected)) << "spike starts";
+  // The spikes' sizes: the per-axis RMS of about 8 000 episodes' draws, within 4 standard errors.
+  const double size_tolerance = 4 / std::sqrt(2 * 3 * expected);
+  EXPECT_NEAR(fit.spike_rotation_sd, options.spike_rotation_sd,
+              size_tolerance * options.spike_rotation_sd);
+  EXPECT_NEAR(fit.spike_translation_sd, options.spike_translation_sd,
+              size_tolerance * options.spike_translation_sd);
 }
 
 TEST(ErrorModelTest, TheCommittedDefaultsAreTheGeneratorsOutput) {
