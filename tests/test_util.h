@@ -18,6 +18,8 @@
 #include <system_error>
 #include <vector>
 
+#include "tests/statistical_frames.h"
+
 #include "core/error.h"
 
 namespace mmh::test_util {
@@ -96,13 +98,12 @@ inline std::string ErrorOf(const std::function<void()>& f) {
   return "(no InputError)";
 }
 
-// Arguments that give `mmh render` (and `run`) the frames the CLI tests' accuracy checks were
-// written against: the statistical sensor with the camera at (0, -0.9, 0.75), the defaults before
-// issue 23 made them structured light at 0.85 m (as tests/track/sim_take.h does for the tracker's
-// tests). Structured-light accuracy is checked by the tracker's structured-light tests and the
-// regression baselines.
-inline constexpr char kStatisticalFrames[] =
-    " --set sensor.mode='\"statistical\"' --set camera.y=-0.9 --set camera.z=0.75";
+// StatisticalFrameSettings as arguments of `mmh render` (and `run`): " --set '...'" each.
+inline std::string StatisticalFramesFlags() {
+  std::string flags;
+  for (const std::string& s : StatisticalFrameSettings()) flags += " --set '" + s + "'";
+  return flags;
+}
 
 struct CommandResult {
   int exit_code = -1;

@@ -70,7 +70,7 @@ TEST_F(RenderCliTest, ItsBopSceneIsReadByTrackAndEval) {
   // (Structured-light frames, the default, measured: median 1.85 deg and 1.73 mm, 7 of 10 frames
   // within 5 deg and 5 cm.)
   const auto rendered = RunMmh("render --quiet --set render.frames=10 --set render.bop=true" +
-                               std::string(test_util::kStatisticalFrames) + " --out " +
+                               test_util::StatisticalFramesFlags() + " --out " +
                                render.string());
   ASSERT_EQ(rendered.exit_code, 0) << rendered.output;
   EXPECT_EQ(ReadBytes(render / "bop" / "depth" / "000009.png"),

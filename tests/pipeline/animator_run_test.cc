@@ -17,16 +17,14 @@ namespace {
 using test_util::ErrorOf;
 
 // A short Soldier scenario: `frames` frames of `takes` takes (the beginning of each take).
-// statistical_frames: the statistical sensor with the camera at (0, -0.9, 0.75), the frames the
-// full-fidelity checks were written for (tests/track/sim_take.h); on structured-light frames, the
+// statistical_frames: test_util::StatisticalFrameSettings, the frames the full-fidelity checks
+// were written for; on structured-light frames, the
 // default, the full-fidelity test below measured 89.3 % success on one take.
 RunConfig ShortConfig(Fidelity fidelity, int frames, int takes = 2,
                       bool statistical_frames = false) {
   Config config;
   if (statistical_frames) {
-    config.Set("sensor.mode=\"statistical\"");
-    config.Set("camera.y=-0.9");
-    config.Set("camera.z=0.75");
+    for (const std::string& s : test_util::StatisticalFrameSettings()) config.Set(s);
   }
   config.Set(std::string("scenario.story=\"") + MMH_SOURCE_DIR + "/configs/stories/soldier.json\"");
   config.Set("scene.props=castle");

@@ -18,6 +18,7 @@
 #include "core/error.h"
 #include "sim/internal/avx2_kernels.h"
 #include "sim/internal/avx512_kernels.h"
+#include "tests/sim/sensor_modes.h"
 #include "tests/test_meshes.h"
 
 namespace mmh::sim {
@@ -39,12 +40,7 @@ Rigid3 FacingCamera(double z, const Eigen::Vector3d& normal = Eigen::Vector3d::U
   return Rigid3(q, Eigen::Vector3d(0, 0, z));
 }
 
-// The statistical mode's options (the default mode is structured light).
-KinectSensorOptions Statistical() {
-  KinectSensorOptions options;
-  options.mode = SensorMode::kStatistical;
-  return options;
-}
+using test_modes::Statistical;
 
 KinectSensorOptions Exact() {
   KinectSensorOptions options = Statistical();

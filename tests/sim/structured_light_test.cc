@@ -12,6 +12,7 @@
 
 #include "core/error.h"
 #include "sim/kinect_sensor.h"
+#include "tests/sim/sensor_modes.h"
 #include "tests/test_meshes.h"
 
 namespace mmh::sim {
@@ -28,11 +29,7 @@ Rigid3 WallAt(double z) {
       Eigen::Vector3d(0, 0, z));
 }
 
-KinectSensorOptions Statistical() {
-  KinectSensorOptions options;
-  options.mode = SensorMode::kStatistical;
-  return options;
-}
+using test_modes::Statistical;
 
 KinectSensorOptions StructuredLight() {
   KinectSensorOptions options;

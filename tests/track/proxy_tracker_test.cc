@@ -430,19 +430,26 @@ TwinFrames CountTwinFrames(test_take::SimTake& take, int frames, int counted_fro
   return count;
 }
 
+// CountTwinFrames on the first `frames` frames of a story take rendered in structured light.
+TwinFrames CountTwinFramesOfStoryTake(const std::string& config_file, int take_index, int frames,
+                                      int counted_from, const ProxyTrackerOptions& other,
+                                      const std::string& reason) {
+  int take_frames = 0;
+  test_take::SimTake take = StructuredLightStoryTake(config_file, take_index, &take_frames);
+  EXPECT_GE(take_frames, frames);
+  return CountTwinFrames(take, std::min(frames, take_frames), counted_from, other, reason);
+}
+
 // A trusted track is held against its half-turn twin (DetectionOptions::hold_trusted).
 // configs/soldier.json's take 1, frames 0-269: at frame 254 the hand over the Soldier's head drops
 // the tracked pose's inlier share just under 0.75 and the detection verifies only the twin. With
 // the hold that frame is predicted and the track stays on the truth; without it the track switches
 // into the twin (measured with `mmh track` on the whole take: 5 frames in the twin from 254).
 TEST(ProxyTrackerTest, StructuredLightTrustedTrackIsHeldAgainstItsTwin) {
-  constexpr int kFrames = 270;
-  int take_frames = 0;
-  test_take::SimTake take = StructuredLightStoryTake("configs/soldier.json", 1, &take_frames);
-  ASSERT_GE(take_frames, kFrames);
   ProxyTrackerOptions unheld;
   unheld.detection.hold_trusted = false;
-  const TwinFrames count = CountTwinFrames(take, kFrames, 0, unheld, "held");
+  const TwinFrames count = CountTwinFramesOfStoryTake("configs/soldier.json", 1, 270, 0, unheld,
+                                                      "held");
   EXPECT_GE(count.with_reason, 1);
   EXPECT_EQ(count.defaults, 0);
   EXPECT_GE(count.other, 3);
@@ -455,13 +462,10 @@ TEST(ProxyTrackerTest, StructuredLightTrustedTrackIsHeldAgainstItsTwin) {
 // the twin on the whole take). Counted from frame 200: the first detection of this take takes the
 // twin for 10 frames either way, before any track is trusted.
 TEST(ProxyTrackerTest, StructuredLightReacquisitionKeepsTheTrust) {
-  constexpr int kFrames = 300;
-  int take_frames = 0;
-  test_take::SimTake take = StructuredLightStoryTake("configs/mario.json", 2, &take_frames);
-  ASSERT_GE(take_frames, kFrames);
   ProxyTrackerOptions untrusted;
   untrusted.detection.reacquire_trust_frames = 0;
-  const TwinFrames count = CountTwinFrames(take, kFrames, 200, untrusted, "");
+  const TwinFrames count =
+      CountTwinFramesOfStoryTake("configs/mario.json", 2, 300, 200, untrusted, "");
   EXPECT_EQ(count.defaults, 0);
   EXPECT_GE(count.other, 20);
 }

@@ -22,22 +22,20 @@
 #include "sim/session_script.h"
 #include "people/story.h"
 #include "track/setup.h"
+#include "tests/statistical_frames.h"
 
 namespace mmh::track::test_take {
 
-// The frames the tracker's unit tests were written against: the statistical sensor with the camera
-// at (0, -0.9, 0.75), 1.17 m from the play area, the renderer's defaults before issue 23 made them
-// structured light at 0.85 m. The tests' thresholds are about the tracker's algorithms on frames
-// with the statistical model's errors; structured-light frames have tests of their own.
-inline void UseStatisticalFrames(sim::RenderConfig* config) {
-  config->sensor.mode = sim::SensorMode::kStatistical;
-  config->camera.y = -0.9;
-  config->camera.z = 0.75;
+// The frames the tracker's unit tests were written against (test_util::StatisticalFrameSettings:
+// the statistical sensor at 1.17 m). The tests' thresholds are about the tracker's algorithms on
+// frames with the statistical model's errors; structured-light frames have tests of their own.
+inline void UseStatisticalFrames(Config* config) {
+  for (const std::string& s : test_util::StatisticalFrameSettings()) config->Set(s);
 }
 inline sim::RenderConfig StatisticalConfig() {
-  sim::RenderConfig config;
+  Config config;
   UseStatisticalFrames(&config);
-  return config;
+  return sim::RenderConfig::FromConfig(config);
 }
 
 class SimTake {
@@ -101,20 +99,22 @@ inline SimTake SoldierStorySession(const std::string& source, int animator, int 
                                    sim::RenderSession session, int* frames,
                                    const std::string& config_file = "configs/study_soldier.json",
                                    bool statistical = true) {
-  const Config file = Config::Load(source + "/" + config_file);
+  Config file = Config::Load(source + "/" + config_file);
+  if (statistical) UseStatisticalFrames(&file);
   sim::RenderConfig config = sim::RenderConfig::FromConfig(file);
-  if (statistical) UseStatisticalFrames(&config);
   people::PeopleConfig people = people::PeopleConfig::FromConfig(file);
-  // The people the tests' takes and their events were measured with, unless the config sets them
-  // (configs/people/calibrated_2026_11_25.json): the recalibration of 2026-11-29 changed the
-  // learning and the annotators' dead band, and with them every performed take.
+  // The people the tests' takes and their events were measured with, unless the config sets them:
+  // the learning and the annotators' dead band of configs/people/calibrated_2026_11_25.json (the
+  // recalibration of 2026-11-29 changed them, and with them every performed take).
+  const people::PeopleConfig measured_with = people::PeopleConfig::FromConfig(
+      Config::Load(source + "/configs/people/calibrated_2026_11_25.json"));
   const nlohmann::json& root = file.root();
   const bool has_population = root.contains("population") && root["population"].is_object();
   if (!has_population || !root["population"].contains("learning_mean")) {
-    people.population.learning_mean = 0.0546;
+    people.population.learning_mean = measured_with.population.learning_mean;
   }
   if (!has_population || !root["population"].contains("move_threshold_mean")) {
-    people.population.move_threshold_mean = 0.984;
+    people.population.move_threshold_mean = measured_with.population.move_threshold_mean;
   }
   people.scenario.story = source + "/" + people.scenario.story;
   people.scenario.animator = animator;

@@ -32,7 +32,7 @@ const fs::path& RenderedTake() {
     // (On structured-light frames, the default, the first detection comes on the third frame.)
     const auto result =
         RunMmh("render --quiet --out " + out.string() + " --set render.frames=60 " +
-               "--set render.fakenect=true" + std::string(test_util::kStatisticalFrames));
+               "--set render.fakenect=true" + test_util::StatisticalFramesFlags());
     EXPECT_EQ(result.exit_code, 0) << result.output;
     return out;
   }();
