@@ -776,7 +776,9 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
     const PooledSpikes fitted =
         FitToMoments(condition, start, Fitted::kEpisodes, gross, 1 << 16, 15, &iterations);
     r.spike_rate = fitted.rate;
-    if (runs.ends[c] > 0) r.spike_mean_frames = fitted.mean_frames;
+    // Without episodes the length is not identified (the iteration leaves it anywhere): the
+    // measured one stays.
+    if (runs.ends[c] > 0 && fitted.rate > 0) r.spike_mean_frames = fitted.mean_frames;
   });
 }
 

@@ -378,7 +378,7 @@ TEST(ErrorModelTest, EpisodesFollowTheViewConditionAndTheEstimatorRecoversThem) 
 TEST(ErrorModelTest, TheCoresOwnExcursionsAreNotSpikes) {
   ErrorModelOptions options;
   options.view = ViewRates::Uniform({});  // no losses, flips or spikes
-  options.rotation_sd = 0.035;            // 2 deg per axis: about 4 % of frames beyond 5 deg
+  options.rotation_sd = 0.035;            // 2 deg per axis: about 10 % of frames beyond 5 deg
   options.translation_sd = 0.002;
   options.correlation = 0.5;
   const int frames = 40000;
@@ -417,8 +417,8 @@ TEST(ErrorModelTest, TheCoresOwnExcursionsAreNotSpikes) {
     // The starts' Poisson sd over this condition's frames, as a rate.
     EXPECT_LT(fit.spike_rate, 4 * std::sqrt(0.03 / m) + 0.002) << ViewConditionName(c);
   }
-  // The truncated RMS understates σ; the fit undoes it.
-  EXPECT_LT(truncated_rms, 0.97 * options.rotation_sd);
+  // The truncated RMS understates σ (by 11 %); the fit undoes it.
+  EXPECT_LT(truncated_rms, 0.95 * options.rotation_sd);
   const double sd_tolerance = 4 * SdRelativeError(n, options.correlation);
   EXPECT_NEAR(estimate.options.rotation_sd, options.rotation_sd,
               sd_tolerance * options.rotation_sd);
@@ -446,10 +446,11 @@ TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
   }
   const ErrorModelEstimate estimate = EstimateErrorModel(tracking, {}, options);
   const ErrorModelOptions& fit = estimate.options;
-  const double n = 3.0 * estimate.inlier_frames;
-  const double sd_tolerance = 4 * SdRelativeError(n, options.correlation);
-  EXPECT_NEAR(fit.rotation_sd, options.rotation_sd, sd_tolerance * options.rotation_sd);
-  EXPECT_NEAR(fit.translation_sd, options.translation_sd, sd_tolerance * options.translation_sd);
+  // 1.5 %: the sampling error of these frames (4 se: 0.7 %) and of the estimator's own simulation
+  // (0.45 %), and the pooled fit's bias where the conditions' spike rates differ (measured up to
+  // 1 % on the translation). By moments alone the translation sd is 6-16 % too large.
+  EXPECT_NEAR(fit.rotation_sd, options.rotation_sd, 0.015 * options.rotation_sd);
+  EXPECT_NEAR(fit.translation_sd, options.translation_sd, 0.015 * options.translation_sd);
   EXPECT_NEAR(fit.correlation, options.correlation, 0.02);
   // Pooled over the frames: Σ_c rate_c · at-risk frames is the expected number of starts.
   double expected = 0, fitted = 0;
