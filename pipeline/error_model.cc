@@ -356,6 +356,7 @@ nlohmann::json ErrorModelEstimate::ToJson() const {
           {"core_excursion_rate", core_excursion_rate},
           {"spike_visibility", spike_visibility},
           {"simulation_iterations", simulation_iterations},
+          {"corrected", corrected},
           {"loss_episodes", loss_episodes},
           {"slider_frames", slider_frames},
           {"slider_missed", slider_missed},
@@ -711,7 +712,11 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
   ErrorModelOptions& fit = estimate->options;
   const Runs& runs = sums.spike_runs;
   const std::int64_t at_risk = runs.Total(runs.at_risk), ends = runs.Total(runs.ends);
+  // Too few gross runs to fit the spikes' sizes from: the moments stay (a study of a few seconds'
+  // takes).
+  constexpr int kMinSpikeEpisodes = 100;
   if (estimate->inlier_frames == 0 || at_risk == 0) return;
+  if (estimate->spike_episodes < kMinSpikeEpisodes) return;
   PooledSpikes measured;
   measured.rotation_sd = fit.rotation_sd;
   measured.translation_sd = fit.translation_sd;
@@ -743,6 +748,19 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
     estimate->core_excursion_rate = SimulatedMoments(core_only, gross).rate;
     estimate->spike_visibility =
         std::max(0.0, measured.rate - estimate->core_excursion_rate) / model.rate;
+    // The model must give back the measured sizes: where no model of this form does (its hidden
+    // spikes alone would exceed the inliers' spread, and the core's sd is driven towards 0), the
+    // moments stay.
+    const PooledSpikes seen = SimulatedMoments(model, gross);
+    const auto off = [](double got, double want) { return std::abs(got - want) > 0.05 * want; };
+    if (off(seen.rotation_sd, measured.rotation_sd) ||
+        off(seen.translation_sd, measured.translation_sd) ||
+        off(seen.spike_rotation_sd, measured.spike_rotation_sd) ||
+        off(seen.spike_translation_sd, measured.spike_translation_sd)) {
+      estimate->core_excursion_rate = 0.0;
+      estimate->spike_visibility = 1.0;
+      return;
+    }
   } else {
     estimate->simulation_iterations = core_iterations;
     estimate->core_excursion_rate = core_rate;
@@ -780,6 +798,7 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
     // measured one stays.
     if (runs.ends[c] > 0 && fitted.rate > 0) r.spike_mean_frames = fitted.mean_frames;
   });
+  estimate->corrected = true;
 }
 
 }  // namespace

@@ -190,6 +190,10 @@ struct ErrorModelEstimate {
   double core_excursion_rate = 0.0;
   double spike_visibility = 1.0;
   int simulation_iterations = 0;
+  // Whether the correction was applied: not with fewer than 100 spike episodes, nor where the
+  // fitted model does not give back the measured sizes within 5 % (then `options` holds the
+  // moments, as `moments` does).
+  bool corrected = false;
   std::int64_t frames = 0;    // tracked frames observed
   std::array<std::int64_t, kViewConditions> condition_frames{};  // of them, per view condition
   std::int64_t inlier_frames = 0;
@@ -231,7 +235,9 @@ struct ErrorModelEstimate {
 // one view condition, from fixed seeds) give the measured pooled moments. The rate per view
 // condition is then (measured rate − the core's own excursion rate) / the spikes' visibility
 // (the share of spike episodes the moments see), the length the measured one times the pooled
-// correction. Losses, flips and the slider keep their moments.
+// correction. Losses, flips and the slider keep their moments. With fewer than 100 spike episodes,
+// or where the fitted model does not give back the measured sizes, the moments stay
+// (`corrected` false).
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
                                       const std::vector<ReadingObservation>& readings,
                                       const ErrorModelOptions& prior = {},

@@ -459,6 +459,7 @@ TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
     expected += options.view.condition[c].spike_rate * m;
     fitted += fit.view.condition[c].spike_rate * m;
   }
+  EXPECT_TRUE(estimate.corrected);
   EXPECT_NEAR(fitted, expected, 4 * std::sqrt(expected)) << "spike starts";
   // The spikes' sizes: the per-axis RMS of about 8 000 episodes' draws, within 4 standard errors.
   const double size_tolerance = 4 / std::sqrt(2 * 3 * expected);
@@ -466,6 +467,26 @@ TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
               size_tolerance * options.spike_rotation_sd);
   EXPECT_NEAR(fit.spike_translation_sd, options.spike_translation_sd,
               size_tolerance * options.spike_translation_sd);
+}
+
+// With fewer than 100 spike episodes (a study of a few seconds' takes) there is nothing to fit the
+// spikes' sizes from: the moments are the fit.
+TEST(ErrorModelTest, AShortSampleKeepsItsMoments) {
+  const ErrorModelOptions options;
+  const Trajectory truth = Walk(600);
+  const SimulatedTracking sim = SimulateTracking(truth, options, 900, kCamera);
+  const ErrorModelEstimate estimate =
+      EstimateErrorModel({{&truth, &sim.tracked, &sim.status, kCamera}}, {}, options);
+  ASSERT_GT(estimate.inlier_frames, 0);
+  ASSERT_LT(estimate.spike_episodes, 100);
+  EXPECT_FALSE(estimate.corrected);
+  EXPECT_EQ(estimate.options.rotation_sd, estimate.moments.rotation_sd);
+  EXPECT_EQ(estimate.options.translation_sd, estimate.moments.translation_sd);
+  EXPECT_EQ(estimate.options.spike_rotation_sd, estimate.moments.spike_rotation_sd);
+  for (int c = 0; c < kViewConditions; ++c) {
+    EXPECT_EQ(estimate.options.view.condition[c].spike_rate,
+              estimate.moments.view.condition[c].spike_rate);
+  }
 }
 
 TEST(ErrorModelTest, TheCommittedDefaultsAreTheGeneratorsOutput) {
