@@ -371,6 +371,27 @@ TEST(ErrorModelTest, EpisodesFollowTheViewConditionAndTheEstimatorRecoversThem) 
   EXPECT_NEAR(lying.spike_mean_frames, 2, 0.4);
 }
 
+// `takes` walks of `frames` frames (`walk`) tracked by the model with seeds first_seed + take, and
+// their observations (pointing into the vectors, which must not be resized afterwards).
+struct SimulatedTakes {
+  std::vector<Trajectory> truths;
+  std::vector<SimulatedTracking> sims;
+  std::vector<TrackingObservation> tracking;
+};
+SimulatedTakes SimulateTakes(const ErrorModelOptions& options, Trajectory (*walk)(int), int takes,
+                             int frames, std::uint64_t first_seed) {
+  SimulatedTakes out;
+  for (int take = 0; take < takes; ++take) out.truths.push_back(walk(frames));
+  for (int take = 0; take < takes; ++take) {
+    out.sims.push_back(SimulateTracking(out.truths[take], options, first_seed + take, kCamera));
+  }
+  for (int take = 0; take < takes; ++take) {
+    out.tracking.push_back(
+        {&out.truths[take], &out.sims[take].tracked, &out.sims[take].status, kCamera});
+  }
+  return out;
+}
+
 // The core process alone, with an sd that crosses the gross thresholds on a few per cent of frames
 // and no spikes: by moments its excursions are spikes and its σ the RMS of the frames within the
 // thresholds (computed here from the definitions); corrected by simulation, the spike rate is 0
@@ -382,18 +403,12 @@ TEST(ErrorModelTest, TheCoresOwnExcursionsAreNotSpikes) {
   options.translation_sd = 0.002;
   options.correlation = 0.5;
   const int frames = 40000;
-  std::vector<Trajectory> truths;
-  std::vector<SimulatedTracking> sims;
-  std::vector<TrackingObservation> tracking;
-  for (int take = 0; take < 3; ++take) truths.push_back(Walk(frames));
-  for (int take = 0; take < 3; ++take) {
-    sims.push_back(SimulateTracking(truths[take], options, 500 + take, kCamera));
-  }
+  const SimulatedTakes takes = SimulateTakes(options, Walk, 3, frames, 500);
+  const auto& [truths, sims, tracking] = takes;
   // The truncated moments, computed here from the definitions.
   double squares = 0, inliers = 0;
   std::int64_t beyond = 0;
   for (int take = 0; take < 3; ++take) {
-    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status, kCamera});
     for (int t = 0; t < frames; ++t) {
       const auto e = Error(truths[take].poses[t], sims[take].tracked.poses[t]);
       if (std::hypot(e[0], e[1], e[2]) > 5 * kPi / 180 || std::hypot(e[3], e[4], e[5]) > 0.01) {
@@ -433,18 +448,8 @@ TEST(ErrorModelTest, TheCoresOwnExcursionsAreNotSpikes) {
 // spikes' rotation sd 10 % too large.)
 TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
   const ErrorModelOptions options;
-  const int frames = 30000;
-  std::vector<Trajectory> truths;
-  std::vector<SimulatedTracking> sims;
-  std::vector<TrackingObservation> tracking;
-  for (int take = 0; take < 4; ++take) truths.push_back(Walk(frames));
-  for (int take = 0; take < 4; ++take) {
-    sims.push_back(SimulateTracking(truths[take], options, 700 + take, kCamera));
-  }
-  for (int take = 0; take < 4; ++take) {
-    tracking.push_back({&truths[take], &sims[take].tracked, &sims[take].status, kCamera});
-  }
-  const ErrorModelEstimate estimate = EstimateErrorModel(tracking, {}, options);
+  const SimulatedTakes takes = SimulateTakes(options, Walk, 4, 30000, 700);
+  const ErrorModelEstimate estimate = EstimateErrorModel(takes.tracking, {}, options);
   const ErrorModelOptions& fit = estimate.options;
   // 1.5 %: the sampling error of these frames (4 se: 0.7 %) and of the estimator's own simulation
   // (0.45 %), and the pooled fit's bias where the conditions' spike rates differ (measured up to
