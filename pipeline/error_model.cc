@@ -95,16 +95,6 @@ Eigen::Quaterniond ExpRotation(const Eigen::Vector3d& r) {
                    : Eigen::Quaterniond::Identity();
 }
 
-// The error of `tracked` against `truth` in the proxy frame: rotation vector and translation.
-std::array<double, 6> PoseError(const Rigid3& truth, const Rigid3& tracked) {
-  Eigen::Quaterniond q = truth.rotation.conjugate() * tracked.rotation;
-  if (q.w() < 0) q.coeffs() = -q.coeffs();
-  const Eigen::AngleAxisd angle_axis(q.normalized());
-  const Eigen::Vector3d r = angle_axis.angle() * angle_axis.axis();
-  const Eigen::Vector3d e = truth.rotation.conjugate() * (tracked.translation - truth.translation);
-  return {r.x(), r.y(), r.z(), e.x(), e.y(), e.z()};
-}
-
 // Runs of true values per view condition: runs starting in it, frames free to start one (not in a
 // run and not excluded, plus the run starts), run frames in it and runs ending after one of them
 // (not counting a run cut by the end of the take).
@@ -182,16 +172,13 @@ void EpisodeRates::Validate(const std::string& prefix) const {
 
 int ViewCondition(const Rigid3& table_T_proxy, const Eigen::Vector3d& table_camera_position,
                   double lying_tilt_deg) {
-  const Eigen::Matrix3d rotation = table_T_proxy.rotation.toRotationMatrix();
-  const double tilt = std::acos(std::clamp(rotation(2, 2), -1.0, 1.0)) * 180.0 / kPi;
-  if (tilt > lying_tilt_deg) return kLying;
-  // The proxy's x axis and the direction to the camera, both in the table plane.
-  const Eigen::Vector3d facing = rotation.col(0);
-  const Eigen::Vector3d to_camera = table_camera_position - table_T_proxy.translation;
-  const double phi = std::atan2(facing.y(), facing.x()) - std::atan2(to_camera.y(), to_camera.x());
-  double degrees = std::fmod(phi * 180.0 / kPi, 360.0);
-  if (degrees < 0) degrees += 360.0;
-  return std::min(kHeadingSectors - 1, static_cast<int>(degrees / (360.0 / kHeadingSectors)));
+  return ViewConditionOf(ProxyHeadingDeg(table_T_proxy, table_camera_position),
+                         ProxyTiltDeg(table_T_proxy), lying_tilt_deg);
+}
+
+int ViewConditionOf(double heading_deg, double tilt_deg, double lying_tilt_deg) {
+  if (tilt_deg > lying_tilt_deg) return kLying;
+  return std::min(kHeadingSectors - 1, static_cast<int>(heading_deg / (360.0 / kHeadingSectors)));
 }
 
 void ErrorModelOptions::Validate(const std::string& prefix) const {
@@ -420,31 +407,23 @@ struct GrossThresholds {
   double translation_m = 0.0;
 };
 
-// One tracking observation's frames into `sums`: each frame classified as lost, a flip (a gross
-// error of more than a half turn), a spike (another gross error) or an inlier, by view condition.
-void AddTracking(const TrackingObservation& obs, std::size_t index, const ErrorModelOptions& prior,
+// One take's frames into `sums`: each frame classified as lost, a flip (a gross error of more than
+// a half turn), a spike (another gross error) or an inlier, by view condition.
+void AddTracking(const TakeFrames& take, const ErrorModelOptions& prior,
                  const GrossThresholds& gross_threshold, PoseErrorSums* sums,
                  ErrorModelEstimate* estimate) {
-  const std::string name = "tracking observation " + std::to_string(index);
-  if (!obs.truth || !obs.tracked || !obs.status) throw InputError(name + ": missing data");
-  const std::size_t n = obs.truth->size();
-  if (obs.tracked->size() != n || obs.status->size() != n) {
-    throw InputError(name + ": truth, tracked and status lengths differ (" + std::to_string(n) +
-                     ", " + std::to_string(obs.tracked->size()) + ", " +
-                     std::to_string(obs.status->size()) + ")");
-  }
-  std::vector<std::array<double, 6>> errors(n);
+  const std::size_t n = take.frames.size();
   std::vector<bool> lost(n), flip(n), spike(n), inlier(n), lost_or_flip(n);
   std::vector<int> condition(n);
   for (std::size_t t = 0; t < n; ++t) {
-    condition[t] =
-        ViewCondition(obs.truth->poses[t], obs.table_camera_position, prior.lying_tilt_deg);
+    const TrackingFrame& f = take.frames[t];
+    condition[t] = ViewConditionOf(f.heading_deg, f.tilt_deg, prior.lying_tilt_deg);
     ++estimate->condition_frames[condition[t]];
-    lost[t] = (*obs.status)[t] == track::TrackStatus::kLost;
+    lost[t] = f.status == track::TrackStatus::kLost;
     if (lost[t]) continue;
-    errors[t] = PoseError(obs.truth->poses[t], obs.tracked->poses[t]);
-    const double angle = std::hypot(errors[t][0], errors[t][1], errors[t][2]);
-    const double distance = std::hypot(errors[t][3], errors[t][4], errors[t][5]);
+    const std::array<double, 6>& error = f.error;
+    const double angle = std::hypot(error[0], error[1], error[2]);
+    const double distance = std::hypot(error[3], error[4], error[5]);
     const bool gross =
         angle > gross_threshold.rotation_rad || distance > gross_threshold.translation_m;
     flip[t] = gross && angle > kPi / 2;
@@ -455,18 +434,19 @@ void AddTracking(const TrackingObservation& obs, std::size_t index, const ErrorM
       sums->flip_distance_sum += distance;
     }
     if (spike[t]) {
-      for (int k = 0; k < 6; ++k) sums->spike_squares[k / 3] += errors[t][k] * errors[t][k];
+      for (int k = 0; k < 6; ++k) sums->spike_squares[k / 3] += error[k] * error[k];
     }
     if (!inlier[t]) continue;
     ++estimate->inlier_frames;
-    for (int k = 0; k < 6; ++k) sums->squares[k / 3] += errors[t][k] * errors[t][k];
+    for (int k = 0; k < 6; ++k) sums->squares[k / 3] += error[k] * error[k];
   }
   for (std::size_t t = 0; t + 1 < n; ++t) {
     if (!inlier[t] || !inlier[t + 1]) continue;
+    const std::array<double, 6>& a = take.frames[t].error;
+    const std::array<double, 6>& b = take.frames[t + 1].error;
     for (int k = 0; k < 6; ++k) {
-      sums->lag_products[k / 3] += errors[t][k] * errors[t + 1][k];
-      sums->lag_squares[k / 3] +=
-          0.5 * (errors[t][k] * errors[t][k] + errors[t + 1][k] * errors[t + 1][k]);
+      sums->lag_products[k / 3] += a[k] * b[k];
+      sums->lag_squares[k / 3] += 0.5 * (a[k] * a[k] + b[k] * b[k]);
     }
   }
   estimate->frames += static_cast<std::int64_t>(n);
@@ -801,24 +781,63 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
   estimate->corrected = true;
 }
 
+// The pose errors' fit (moments, then the correction) from the takes' frames, and the slider's.
+ErrorModelEstimate Estimate(const std::vector<const TakeFrames*>& takes,
+                            const std::vector<ReadingObservation>& readings,
+                            const ErrorModelOptions& prior, double gross_threshold_deg,
+                            double gross_threshold_m) {
+  ErrorModelEstimate estimate;
+  estimate.options = prior;
+  const GrossThresholds gross{gross_threshold_deg * kPi / 180.0, gross_threshold_m};
+  PoseErrorSums sums;
+  for (const TakeFrames* take : takes) AddTracking(*take, prior, gross, &sums, &estimate);
+  FitPoseErrors(sums, &estimate);
+  estimate.moments = estimate.options;
+  CorrectBySimulation(sums, gross, &estimate);
+  FitSlider(readings, &estimate);
+  return estimate;
+}
+
 }  // namespace
 
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
                                       const std::vector<ReadingObservation>& readings,
                                       const ErrorModelOptions& prior, double gross_threshold_deg,
                                       double gross_threshold_m) {
-  ErrorModelEstimate estimate;
-  estimate.options = prior;
-  const GrossThresholds gross{gross_threshold_deg * kPi / 180.0, gross_threshold_m};
-  PoseErrorSums sums;
+  std::vector<TakeFrames> frames;
+  std::vector<const TakeFrames*> takes;
+  frames.reserve(tracking.size());
   for (std::size_t i = 0; i < tracking.size(); ++i) {
-    AddTracking(tracking[i], i, prior, gross, &sums, &estimate);
+    frames.push_back(MeasureTakeFrames("", static_cast<int>(i), tracking[i], nullptr));
   }
-  FitPoseErrors(sums, &estimate);
-  estimate.moments = estimate.options;
-  CorrectBySimulation(sums, gross, &estimate);
-  FitSlider(readings, &estimate);
-  return estimate;
+  for (const TakeFrames& take : frames) takes.push_back(&take);
+  return Estimate(takes, readings, prior, gross_threshold_deg, gross_threshold_m);
+}
+
+ErrorModelEstimate EstimateErrorModel(const std::vector<TakeFrames>& frames,
+                                      const ErrorModelOptions& prior, double gross_threshold_deg,
+                                      double gross_threshold_m) {
+  std::vector<const TakeFrames*> takes;
+  // The slider readings of the annotated takes, as ReadingObservations.
+  std::vector<Annotation> truth, read;
+  std::vector<std::vector<bool>> found;
+  for (const TakeFrames& take : frames) {
+    takes.push_back(&take);
+    if (take.frames.empty() || !take.frames.front().has_slider) continue;
+    Annotation& a = truth.emplace_back();
+    Annotation& b = read.emplace_back();
+    std::vector<bool>& c = found.emplace_back();
+    for (const TrackingFrame& f : take.frames) {
+      a.timestamps.push_back(f.time);
+      a.values.push_back(f.slider_truth);
+      b.timestamps.push_back(f.time);
+      b.values.push_back(f.slider_read);
+      c.push_back(f.slider_found);
+    }
+  }
+  std::vector<ReadingObservation> readings;
+  for (std::size_t i = 0; i < truth.size(); ++i) readings.push_back({&truth[i], &read[i], &found[i]});
+  return Estimate(takes, readings, prior, gross_threshold_deg, gross_threshold_m);
 }
 
 }  // namespace mmh::pipeline

@@ -40,6 +40,7 @@
 
 #include "core/annotation.h"
 #include "core/trajectory.h"
+#include "pipeline/tracking_frames.h"
 #include "track/proxy_tracker.h"
 
 namespace mmh::pipeline {
@@ -143,6 +144,8 @@ struct ErrorModelOptions {
 // `table_camera_position` (the camera's centre in the table frame).
 int ViewCondition(const Rigid3& table_T_proxy, const Eigen::Vector3d& table_camera_position,
                   double lying_tilt_deg);
+// The same from the pose's heading and tilt (ProxyHeadingDeg, ProxyTiltDeg).
+int ViewConditionOf(double heading_deg, double tilt_deg, double lying_tilt_deg);
 
 struct SimulatedTracking {
   Trajectory tracked;  // table_T_proxy, #frames (lost frames: the last reported pose held)
@@ -165,21 +168,6 @@ SimulatedReading SimulateSliderReading(const Annotation& truth, const ErrorModel
                                        std::uint64_t seed);
 
 // ---- Measuring the model on full-fidelity runs -------------------------------------------------
-
-// One tracked take against its ground truth (all #frames).
-struct TrackingObservation {
-  const Trajectory* truth = nullptr;    // table_T_proxy
-  const Trajectory* tracked = nullptr;  // table_T_proxy as reported
-  const std::vector<track::TrackStatus>* status = nullptr;
-  Eigen::Vector3d table_camera_position = Eigen::Vector3d::Zero();  // the camera's centre
-};
-
-// One slider reading against the block's true values (all #frames).
-struct ReadingObservation {
-  const Annotation* truth = nullptr;
-  const Annotation* read = nullptr;
-  const std::vector<bool>* found = nullptr;
-};
 
 struct ErrorModelEstimate {
   ErrorModelOptions options;  // the fitted model (fields without data keep `prior`'s values)
@@ -240,6 +228,13 @@ struct ErrorModelEstimate {
 // (`corrected` false).
 ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tracking,
                                       const std::vector<ReadingObservation>& readings,
+                                      const ErrorModelOptions& prior = {},
+                                      double gross_threshold_deg = 5.0,
+                                      double gross_threshold_m = 0.01);
+// The same fit from the per-frame table (pipeline/tracking_frames.h; a study's
+// tracking_frames.csv): the tracking of every take, the slider of the takes that have one. Gives
+// the bytes of the fit above on the observations the table was measured from.
+ErrorModelEstimate EstimateErrorModel(const std::vector<TakeFrames>& takes,
                                       const ErrorModelOptions& prior = {},
                                       double gross_threshold_deg = 5.0,
                                       double gross_threshold_m = 0.01);

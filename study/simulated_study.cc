@@ -182,17 +182,18 @@ SimulatedStudy RunSimulatedStudy(const StudyConfig& config, int replicate,
   for (const auto& a : study.animators) study.rendered_frames += a.rendered_frames;
 
   if (config.run.run.fidelity == pipeline::Fidelity::kFull) {
-    std::vector<pipeline::TrackingObservation> tracking;
-    std::vector<pipeline::ReadingObservation> readings;
     for (const auto& a : study.animators) {
       for (const auto& take : a.takes) {
-        tracking.push_back(
-            {&take.truth, &take.tracked, &take.status, take.camera_T_table.Inverse().translation});
-        readings.push_back({&take.truth_annotation, &take.read_annotation, &take.slider_found});
+        const pipeline::TrackingObservation tracking{
+            &take.truth, &take.tracked, &take.status, take.camera_T_table.Inverse().translation};
+        const pipeline::ReadingObservation reading{&take.truth_annotation, &take.read_annotation,
+                                                   &take.slider_found};
+        study.tracking_frames.push_back(pipeline::MeasureTakeFrames(
+            a.id, take.take, tracking, take.truth_annotation.values.empty() ? nullptr : &reading));
       }
     }
     study.measured_error_model =
-        pipeline::EstimateErrorModel(tracking, readings, config.run.error_model);
+        pipeline::EstimateErrorModel(study.tracking_frames, config.run.error_model);
   }
   study.scoring_seconds = SecondsSince(scoring_start);
   return study;

@@ -100,7 +100,9 @@ struct SimulatedStudy {
   ScoringDesign design;
   StudyData data;
   StudyAnalysis analysis;
-  // Full fidelity: the error model measured on this study's tracked takes and readings.
+  // Full fidelity: every tracked frame against its truth (tracking_frames.csv), and the error model
+  // measured on them.
+  std::vector<pipeline::TakeFrames> tracking_frames;
   std::optional<pipeline::ErrorModelEstimate> measured_error_model;
   double animator_seconds = 0.0;  // wall clock of phase 1
   double scoring_seconds = 0.0;   // phase 2 and the analysis

@@ -7,6 +7,7 @@
 #include "core/staged_folder.h"
 #include "core/text_parsing.h"
 #include "pipeline/run_metrics.h"
+#include "pipeline/tracking_frames.h"
 
 namespace mmh::study {
 namespace {
@@ -182,6 +183,9 @@ void WriteStudyFolder(const std::filesystem::path& out_dir, const StudyConfig& c
   if (replicates > 1) {
     WriteFileAtomically(out / "replicates.csv", r.replicates_csv);
     WriteFileAtomically(out / "power.csv", PowerCsv(r.power));
+  }
+  if (!s.tracking_frames.empty()) {
+    WriteFileAtomically(out / "tracking_frames.csv", pipeline::TakeFramesCsv(s.tracking_frames));
   }
   if (s.measured_error_model) {
     // The fit as pipeline/error_model.inc: copying it there makes it the fast mode's defaults.
