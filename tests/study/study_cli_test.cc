@@ -2,6 +2,7 @@
 // them, same bytes on a rerun with another thread count, replicates, and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -50,6 +51,27 @@ TEST(StudyCliTest, FullFidelityWritesTheErrorModelFit) {
   EXPECT_GT(translation_sd, 1e-4);  // the tracker's jitter, about a millimetre
   EXPECT_LT(translation_sd, 1e-2);
   EXPECT_NE(fit.find("inline constexpr ViewRates kView"), std::string::npos);
+
+  // Every tracked frame is in tracking_frames.csv (and a header), and `mmh error-model` fitted on
+  // it gives the study's fit, number for number.
+  const std::string frames = ReadBytes(out / "tracking_frames.csv");
+  EXPECT_EQ(std::count(frames.begin(), frames.end(), '\n'), 549 + 1);
+  const auto refit = RunMmh("error-model --frames " + (out / "tracking_frames.csv").string() +
+                            " --quiet --out " + (dir / "refit").string());
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  const auto results = nlohmann::json::parse(ReadBytes(out / "results.json"));
+  EXPECT_EQ(nlohmann::json::parse(ReadBytes(dir / "refit" / "error_model.json")),
+            results["measured_error_model"]);
+  const std::string refit_inc = ReadBytes(dir / "refit" / "error_model.inc");
+  EXPECT_EQ(refit_inc.substr(refit_inc.find("tracked frames")), fit.substr(fit.find("tracked frames")));
+
+  // A damaged table: exit code 2, the file and line named, nothing written.
+  test_util::WriteText(dir / "bad.csv", frames.substr(0, frames.find('\n') + 1) + "A01,0,0,x\n");
+  const auto bad = RunMmh("error-model --frames " + (dir / "bad.csv").string() + " --out " +
+                          (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("bad.csv:2: 4 fields, expected 18"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad" / "error_model.inc"));
 }
 
 TEST(StudyCliTest, WritesEverythingAndStatsReproducesIt) {
