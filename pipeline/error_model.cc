@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <vector>
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
@@ -24,7 +26,9 @@ enum Stream : std::uint64_t {
   kSliderStream,
   kSpikeStream,
   kFlipShapeStream,
-  kSpikeShapeStream
+  kSpikeShapeStream,
+  kSlowStream,
+  kFlipLostStream
 };
 
 void RequireCorrelation(double value, const std::string& where) {
@@ -52,6 +56,34 @@ class Ar1 {
   double x_ = 0.0;
   bool started_ = false;
 };
+
+// The core error of one axis (the header's x_t = s_t + f_t): the fast jitter f from `random`, the
+// slow drift s from `slow_random` (not drawn where w = 0, so that the single AR(1) keeps its draws).
+class Core {
+ public:
+  Core(double sd, double correlation, double slow_share, double slow_correlation)
+      : fast_(sd * std::sqrt(1.0 - slow_share), correlation),
+        slow_(sd * std::sqrt(slow_share), slow_correlation),
+        has_slow_(slow_share > 0) {}
+  double Next(people::Random& random, people::Random& slow_random) {
+    const double fast = fast_.Next(random);
+    return has_slow_ ? fast + slow_.Next(slow_random) : fast;
+  }
+
+ private:
+  Ar1 fast_, slow_;
+  bool has_slow_;
+};
+
+// The six axes' cores of `options`-like sds and time scales: rotation x3, translation x3.
+template <class T>
+std::array<Core, 6> CoreAxes(const T& m) {
+  const auto axis = [&](double sd) {
+    return Core(sd, m.correlation, m.slow_share, m.slow_correlation);
+  };
+  return {axis(m.rotation_sd),    axis(m.rotation_sd),    axis(m.rotation_sd),
+          axis(m.translation_sd), axis(m.translation_sd), axis(m.translation_sd)};
+}
 
 // Episodes of one kind on `frames` frames: an episode starts at a free frame t with probability
 // rate(c[t]) and ends after each of its frames u with probability 1 / mean_frames(c[u]) (the
@@ -185,12 +217,19 @@ void ErrorModelOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(translation_sd, prefix + ".translation_sd", "m");
   RequireNonNegative(rotation_sd, prefix + ".rotation_sd", "rad");
   RequireCorrelation(correlation, prefix + ".correlation");
+  RequireProbability(slow_share, prefix + ".slow_share");
+  RequireCorrelation(slow_correlation, prefix + ".slow_correlation");
   RequireFinite(flip_rotation, prefix + ".flip_rotation");
   if (flip_rotation < 0 || flip_rotation > kPi) {
     ThrowBadValue(prefix + ".flip_rotation", FormatNumber(flip_rotation),
                   "an angle in [0, pi] rad");
   }
   RequireNonNegative(flip_translation, prefix + ".flip_translation", "m");
+  RequireProbability(flip_lost_share, prefix + ".flip_lost_share");
+  if (flip_lost_share >= 1.0) {
+    ThrowBadValue(prefix + ".flip_lost_share", FormatNumber(flip_lost_share),
+                  "a share below 1 (a flip shows its twin)");
+  }
   RequireNonNegative(spike_rotation_sd, prefix + ".spike_rotation_sd", "rad");
   RequireNonNegative(spike_translation_sd, prefix + ".spike_translation_sd", "m");
   RequireFinite(lying_tilt_deg, prefix + ".lying_tilt_deg");
@@ -231,23 +270,25 @@ SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOpti
 
   const std::vector<int> none(frames, -1);
   const ViewRates& view = options.view;
-  const std::vector<int> lost =
-      DrawEpisodes(condition, view, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, none,
-                   people::DeriveSeed(seed, {kLossStream}));
   const std::vector<int> flip =
-      DrawEpisodes(condition, view, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, lost,
+      DrawEpisodes(condition, view, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, none,
                    people::DeriveSeed(seed, {kFlipStream}));
+  const std::vector<int> lost =
+      DrawEpisodes(condition, view, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, flip,
+                   people::DeriveSeed(seed, {kLossStream}));
+  // A flip's own lost frames (the tracker loses the proxy and finds the twin again).
+  std::vector<bool> flip_lost(frames, false);
+  people::Random flip_lost_random(people::DeriveSeed(seed, {kFlipLostStream}));
+  for (int t = 0; t < frames; ++t) {
+    if (flip[t] >= 0) flip_lost[t] = flip_lost_random.Bernoulli(options.flip_lost_share);
+  }
   const std::vector<int> spike =
       DrawEpisodes(condition, view, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames,
                    Union(lost, flip), people::DeriveSeed(seed, {kSpikeStream}));
 
   people::Random random(people::DeriveSeed(seed, {kPoseStream}));
-  std::array<Ar1, 6> axes = {Ar1(options.rotation_sd, options.correlation),
-                             Ar1(options.rotation_sd, options.correlation),
-                             Ar1(options.rotation_sd, options.correlation),
-                             Ar1(options.translation_sd, options.correlation),
-                             Ar1(options.translation_sd, options.correlation),
-                             Ar1(options.translation_sd, options.correlation)};
+  people::Random slow_random(people::DeriveSeed(seed, {kSlowStream}));
+  std::array<Core, 6> axes = CoreAxes(options);
   const Eigen::Quaterniond twin(Eigen::AngleAxisd(options.flip_rotation, Eigen::Vector3d::UnitZ()));
   // Each episode's shape: a flip's horizontal offset direction, a spike's error.
   people::Random flip_shape(people::DeriveSeed(seed, {kFlipShapeStream}));
@@ -259,8 +300,8 @@ SimulatedTracking SimulateTracking(const Trajectory& truth, const ErrorModelOpti
     // The error processes run on through the episodes (the tracker's bias drifts with the view
     // either way), so the draws of a frame do not depend on them.
     std::array<double, 6> x;
-    for (int k = 0; k < 6; ++k) x[k] = axes[k].Next(random);
-    if (lost[t] >= 0) {
+    for (int k = 0; k < 6; ++k) x[k] = axes[k].Next(random, slow_random);
+    if (lost[t] >= 0 || flip_lost[t]) {
       out.status[t] = track::TrackStatus::kLost;
       out.tracked.poses[t] = t > 0 ? out.tracked.poses[t - 1] : truth.poses[t];
       continue;
@@ -337,10 +378,12 @@ nlohmann::json ErrorModelEstimate::ToJson() const {
           {"flip_frames", flip_frames},
           {"spike_frames", spike_frames},
           {"lost_frames", lost_frames},
+          {"flip_lost_frames", flip_lost_frames},
           {"flip_episodes", flip_episodes},
           {"spike_episodes", spike_episodes},
           {"moments", mmh::ToJson(moments)},
           {"core_excursion_rate", core_excursion_rate},
+          {"core_autocorrelation", core_autocorrelation},
           {"spike_visibility", spike_visibility},
           {"simulation_iterations", simulation_iterations},
           {"corrected", corrected},
@@ -367,8 +410,11 @@ std::string ErrorModelEstimate::DefaultsSource(const std::string& origin) const 
   constant("kTranslationSd", o.translation_sd);
   constant("kRotationSd", o.rotation_sd);
   constant("kCorrelation", o.correlation);
+  constant("kSlowShare", o.slow_share);
+  constant("kSlowCorrelation", o.slow_correlation);
   constant("kFlipRotation", o.flip_rotation);
   constant("kFlipTranslation", o.flip_translation);
+  constant("kFlipLostShare", o.flip_lost_share);
   constant("kSpikeRotationSd", o.spike_rotation_sd);
   constant("kSpikeTranslationSd", o.spike_translation_sd);
   constant("kSliderSd", o.slider_sd);
@@ -392,13 +438,17 @@ std::string ErrorModelEstimate::DefaultsSource(const std::string& origin) const 
 namespace {
 
 // What the pose errors of the tracking observations add up to: per type (0 rotation,
-// 1 translation) the sum of squares over inlier frames, and over consecutive inlier pairs the
-// lag-one products and the mean squares of the pair; the episodes' runs; over flip frames the sums
-// of the error angle and distance, over spike frames the squares per type.
+// 1 translation) the sum of squares over inlier frames, and per lag k = 1 .. kCoreLags over the
+// pairs of inlier frames k apart the products and the mean squares of the pair; the episodes'
+// runs; over twin frames the sums of the error angle and distance and their count, the lost
+// frames inside flip episodes, over spike frames the squares per type.
+using LagSums = std::array<std::array<double, 2>, kCoreLags>;
 struct PoseErrorSums {
-  std::array<double, 2> squares = {0, 0}, lag_products = {0, 0}, lag_squares = {0, 0};
+  std::array<double, 2> squares = {0, 0};
+  LagSums lag_products{}, lag_squares{};
   Runs flip_runs, spike_runs, loss_runs;
   double flip_angle_sum = 0, flip_distance_sum = 0;
+  std::int64_t twin_frames = 0, flip_lost_frames = 0;
   std::array<double, 2> spike_squares = {0, 0};
 };
 
@@ -440,28 +490,116 @@ void AddTracking(const TakeFrames& take, const ErrorModelOptions& prior,
     ++estimate->inlier_frames;
     for (int k = 0; k < 6; ++k) sums->squares[k / 3] += error[k] * error[k];
   }
-  for (std::size_t t = 0; t + 1 < n; ++t) {
-    if (!inlier[t] || !inlier[t + 1]) continue;
-    const std::array<double, 6>& a = take.frames[t].error;
-    const std::array<double, 6>& b = take.frames[t + 1].error;
-    for (int k = 0; k < 6; ++k) {
-      sums->lag_products[k / 3] += a[k] * b[k];
-      sums->lag_squares[k / 3] += 0.5 * (a[k] * a[k] + b[k] * b[k]);
+  for (int lag = 1; lag <= kCoreLags; ++lag) {
+    for (std::size_t t = 0; t + lag < n; ++t) {
+      if (!inlier[t] || !inlier[t + lag]) continue;
+      const std::array<double, 6>& a = take.frames[t].error;
+      const std::array<double, 6>& b = take.frames[t + lag].error;
+      for (int k = 0; k < 6; ++k) {
+        sums->lag_products[lag - 1][k / 3] += a[k] * b[k];
+        sums->lag_squares[lag - 1][k / 3] += 0.5 * (a[k] * a[k] + b[k] * b[k]);
+      }
     }
   }
   estimate->frames += static_cast<std::int64_t>(n);
-  CountRuns(lost, std::vector<bool>(n, false), condition, &sums->loss_runs);
+  // Flip episodes: the runs of twin and lost frames that hold a twin frame.
+  std::vector<bool> in_flip(n, false), other_lost(n, false);
+  for (std::size_t t = 0; t < n;) {
+    if (!(lost[t] || flip[t])) {
+      ++t;
+      continue;
+    }
+    std::size_t end = t;
+    bool twin = false;
+    while (end < n && (lost[end] || flip[end])) twin = twin || flip[end], ++end;
+    for (std::size_t u = t; u < end; ++u) {
+      in_flip[u] = twin;
+      other_lost[u] = !twin;
+      if (twin && lost[u]) ++sums->flip_lost_frames;
+      if (flip[u]) ++sums->twin_frames;
+    }
+    t = end;
+  }
   for (std::size_t t = 0; t < n; ++t) lost_or_flip[t] = lost[t] || flip[t];
-  CountRuns(flip, lost, condition, &sums->flip_runs);
+  CountRuns(in_flip, std::vector<bool>(n, false), condition, &sums->flip_runs);
+  CountRuns(other_lost, in_flip, condition, &sums->loss_runs);
   CountRuns(spike, lost_or_flip, condition, &sums->spike_runs);
 }
 
-// The pose error's parameters from the sums: inlier sds per axis, the lag-one correlation pooled
-// over the six components (each type scaled by its variance), the episodes' hazards per view
-// condition, and the flips' and spikes' sizes.
+// The core's time scales: the drift's share w and lag one ρ_s, the jitter's lag one ρ_f.
+struct TimeScales {
+  double slow_share = 0.0, slow_correlation = 0.0, correlation = 0.0;
+};
+using Autocorrelation = std::array<double, kCoreLags>;
+
+// w ρ_s^k + (1 − w) ρ_f^k at lags 1 .. kCoreLags.
+Autocorrelation ModelAutocorrelation(const TimeScales& m) {
+  Autocorrelation out;
+  double s = 1.0, f = 1.0;
+  for (int k = 0; k < kCoreLags; ++k) {
+    s *= m.slow_correlation;
+    f *= m.correlation;
+    out[k] = m.slow_share * s + (1.0 - m.slow_share) * f;
+  }
+  return out;
+}
+
+// The time scales whose autocorrelation is nearest to `acf` in least squares: ρ_s and ρ_f ≤ ρ_s
+// on the grid i / 1000, i = 0 .. 999 (every pair tried), w in [0, 1] in closed form for each pair
+// (the residual acf_k − ρ_f^k is linear in w with slope ρ_s^k − ρ_f^k). Ties keep the first pair.
+TimeScales FitTimeScales(const Autocorrelation& acf) {
+  constexpr int kGrid = 1000;
+  static const std::vector<Autocorrelation> powers = [] {
+    std::vector<Autocorrelation> p(kGrid);
+    for (int i = 0; i < kGrid; ++i) p[i] = ModelAutocorrelation({0.0, 0.0, i / double{kGrid}});
+    return p;
+  }();
+  TimeScales best;
+  double best_error = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < kGrid; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      double ab = 0, bb = 0, aa = 0;
+      for (int k = 0; k < kCoreLags; ++k) {
+        const double a = acf[k] - powers[j][k], b = powers[i][k] - powers[j][k];
+        ab += a * b;
+        bb += b * b;
+        aa += a * a;
+      }
+      const double w = bb > 0 ? std::clamp(ab / bb, 0.0, 1.0) : 0.0;
+      const double error = aa - 2 * w * ab + w * w * bb;
+      if (error < best_error) {
+        best_error = error;
+        best = {w, i / double{kGrid}, j / double{kGrid}};
+      }
+    }
+  }
+  return best;
+}
+
+// The autocorrelation at each lag pooled over the two types, each scaled by its variance
+// sd[type]²; false where a lag has no pairs.
+bool PooledAutocorrelation(const LagSums& products, const LagSums& squares,
+                           const std::array<double, 2>& sd, Autocorrelation* acf) {
+  for (int k = 0; k < kCoreLags; ++k) {
+    double numerator = 0, denominator = 0;
+    for (int type = 0; type < 2; ++type) {
+      if (sd[type] <= 0 || squares[k][type] <= 0) continue;
+      numerator += products[k][type] / (sd[type] * sd[type]);
+      denominator += squares[k][type] / (sd[type] * sd[type]);
+    }
+    if (!(denominator > 0)) return false;
+    (*acf)[k] = numerator / denominator;
+  }
+  return true;
+}
+
+// The pose error's parameters from the sums: inlier sds per axis, the core's time scales from the
+// autocorrelation pooled over the six components (each type scaled by its variance), the
+// episodes' hazards per view condition, and the flips' and spikes' sizes.
 void FitPoseErrors(const PoseErrorSums& sums, ErrorModelEstimate* estimate) {
   estimate->lost_frames = sums.loss_runs.Total(sums.loss_runs.frames);
   estimate->flip_frames = sums.flip_runs.Total(sums.flip_runs.frames);
+  estimate->flip_lost_frames = sums.flip_lost_frames;
   estimate->spike_frames = sums.spike_runs.Total(sums.spike_runs.frames);
   estimate->loss_episodes = static_cast<int>(sums.loss_runs.Total(sums.loss_runs.starts));
   estimate->flip_episodes = static_cast<int>(sums.flip_runs.Total(sums.flip_runs.starts));
@@ -472,22 +610,26 @@ void FitPoseErrors(const PoseErrorSums& sums, ErrorModelEstimate* estimate) {
     fit.rotation_sd = std::sqrt(sums.squares[0] / axes);
     fit.translation_sd = std::sqrt(sums.squares[1] / axes);
   }
-  double numerator = 0, denominator = 0;
-  for (int type = 0; type < 2; ++type) {
-    const double sd = type == 0 ? fit.rotation_sd : fit.translation_sd;
-    if (sd <= 0 || sums.lag_squares[type] <= 0) continue;
-    numerator += sums.lag_products[type] / (sd * sd);
-    denominator += sums.lag_squares[type] / (sd * sd);
+  if (PooledAutocorrelation(sums.lag_products, sums.lag_squares,
+                            {fit.rotation_sd, fit.translation_sd},
+                            &estimate->core_autocorrelation)) {
+    const TimeScales scales = FitTimeScales(estimate->core_autocorrelation);
+    fit.slow_share = scales.slow_share;
+    fit.slow_correlation = scales.slow_correlation;
+    fit.correlation = scales.correlation;
   }
-  if (denominator > 0) fit.correlation = std::clamp(numerator / denominator, 0.0, 0.999);
   FitHazards(sums.loss_runs, &EpisodeRates::loss_rate, &EpisodeRates::loss_mean_frames, &fit.view);
   FitHazards(sums.flip_runs, &EpisodeRates::flip_rate, &EpisodeRates::flip_mean_frames, &fit.view);
   FitHazards(sums.spike_runs, &EpisodeRates::spike_rate, &EpisodeRates::spike_mean_frames,
              &fit.view);
-  if (estimate->flip_frames > 0) {
-    const double frames = static_cast<double>(estimate->flip_frames);
+  if (sums.twin_frames > 0) {
+    const double frames = static_cast<double>(sums.twin_frames);
     fit.flip_rotation = sums.flip_angle_sum / frames;
     fit.flip_translation = sums.flip_distance_sum / frames;
+  }
+  if (estimate->flip_frames > 0) {
+    fit.flip_lost_share = static_cast<double>(sums.flip_lost_frames) /
+                          static_cast<double>(estimate->flip_frames);
   }
   if (estimate->spike_frames > 0) {
     const double frames = static_cast<double>(estimate->spike_frames);
@@ -555,12 +697,22 @@ void FitSlider(const std::vector<ReadingObservation>& readings, ErrorModelEstima
 // The parts of the model the correction fits, pooled over the view conditions, and the same
 // quantities as the moment fit measures them.
 struct PooledSpikes {
-  double rotation_sd = 0.0, translation_sd = 0.0, correlation = 0.0;
+  double rotation_sd = 0.0, translation_sd = 0.0;
+  double correlation = 0.0, slow_share = 0.0, slow_correlation = 0.0;  // the core's time scales
   double rate = 0.0, mean_frames = 1.0;  // spike episodes per free frame, mean length
   double spike_rotation_sd = 0.0, spike_translation_sd = 0.0;
+  // As measured: the inliers' pooled autocorrelation at lags 1 .. kCoreLags.
+  Autocorrelation acf{};
+
+  TimeScales Scales() const { return {slow_share, slow_correlation, correlation}; }
+  void SetScales(const TimeScales& m) {
+    slow_share = m.slow_share;
+    slow_correlation = m.slow_correlation;
+    correlation = m.correlation;
+  }
 };
 
-// The moments of `model`'s frames: `frames` frames of the six AR(1) axes with spike
+// The moments of `model`'s frames: `frames` frames of the six axes' cores with spike
 // episodes drawn as SimulateTracking draws them (one view condition), split at the thresholds as
 // AddTracking splits them and fitted as FitPoseErrors fits them. Fixed seeds: the same random
 // numbers in every call, so the result is a deterministic function of the model.
@@ -568,17 +720,19 @@ PooledSpikes SimulatedMoments(const PooledSpikes& model, const GrossThresholds& 
                               int frames = 1 << 18) {
   constexpr std::uint64_t kSeed = 0x6d6f6d656e7473;  // "moments"
   people::Random core_random(people::DeriveSeed(kSeed, {kPoseStream}));
+  people::Random slow_random(people::DeriveSeed(kSeed, {kSlowStream}));
   people::Random episode_random(people::DeriveSeed(kSeed, {kSpikeStream}));
   people::Random shape_random(people::DeriveSeed(kSeed, {kSpikeShapeStream}));
-  std::array<Ar1, 6> axes = {
-      Ar1(model.rotation_sd, model.correlation),    Ar1(model.rotation_sd, model.correlation),
-      Ar1(model.rotation_sd, model.correlation),    Ar1(model.translation_sd, model.correlation),
-      Ar1(model.translation_sd, model.correlation), Ar1(model.translation_sd, model.correlation)};
-  std::array<double, 2> squares = {0, 0}, lag_products = {0, 0}, lag_squares = {0, 0};
+  std::array<Core, 6> axes = CoreAxes(model);
+  std::array<double, 2> squares = {0, 0};
+  LagSums lag_products{}, lag_squares{};
   std::array<double, 2> spike_squares = {0, 0};
   std::int64_t inliers = 0, starts = 0, at_risk = 0, spike_frames = 0, ends = 0;
-  std::array<double, 6> spike{}, previous{};
-  bool in_episode = false, previous_inlier = false, previous_spike = false;
+  std::array<double, 6> spike{};
+  // The last kCoreLags frames' errors and whether they were inliers (frame t in slot t % lags).
+  std::array<std::array<double, 6>, kCoreLags> history{};
+  std::array<bool, kCoreLags> history_inlier{};
+  bool in_episode = false, previous_spike = false;
   for (int t = 0; t < frames; ++t) {
     // The episode chain first (DrawEpisodes), then the frame's error (SimulateTracking).
     bool spiking = in_episode;
@@ -589,7 +743,9 @@ PooledSpikes SimulatedMoments(const PooledSpikes& model, const GrossThresholds& 
     }
     if (in_episode && episode_random.Bernoulli(1.0 / model.mean_frames)) in_episode = false;
     std::array<double, 6> x;
-    for (int k = 0; k < 6; ++k) x[k] = axes[k].Next(core_random) + (spiking ? spike[k] : 0.0);
+    for (int k = 0; k < 6; ++k) {
+      x[k] = axes[k].Next(core_random, slow_random) + (spiking ? spike[k] : 0.0);
+    }
     const double angle = std::hypot(x[0], x[1], x[2]);
     const bool gross_frame =
         angle > gross.rotation_rad || std::hypot(x[3], x[4], x[5]) > gross.translation_m;
@@ -607,15 +763,18 @@ PooledSpikes SimulatedMoments(const PooledSpikes& model, const GrossThresholds& 
     if (!gross_frame) {
       ++inliers;
       for (int k = 0; k < 6; ++k) squares[k / 3] += x[k] * x[k];
-      if (previous_inlier) {
+      for (int lag = 1; lag <= std::min(t, kCoreLags); ++lag) {
+        const int slot = (t - lag) % kCoreLags;
+        if (!history_inlier[slot]) continue;
+        const std::array<double, 6>& before = history[slot];
         for (int k = 0; k < 6; ++k) {
-          lag_products[k / 3] += previous[k] * x[k];
-          lag_squares[k / 3] += 0.5 * (previous[k] * previous[k] + x[k] * x[k]);
+          lag_products[lag - 1][k / 3] += before[k] * x[k];
+          lag_squares[lag - 1][k / 3] += 0.5 * (before[k] * before[k] + x[k] * x[k]);
         }
       }
     }
-    previous = x;
-    previous_inlier = !gross_frame;
+    history[t % kCoreLags] = x;
+    history_inlier[t % kCoreLags] = !gross_frame;
     previous_spike = spike_frame;
   }
   PooledSpikes seen = model;
@@ -623,14 +782,8 @@ PooledSpikes SimulatedMoments(const PooledSpikes& model, const GrossThresholds& 
     seen.rotation_sd = std::sqrt(squares[0] / (3.0 * static_cast<double>(inliers)));
     seen.translation_sd = std::sqrt(squares[1] / (3.0 * static_cast<double>(inliers)));
   }
-  double numerator = 0, denominator = 0;
-  const std::array<double, 2> sds = {seen.rotation_sd, seen.translation_sd};
-  for (int type = 0; type < 2; ++type) {
-    if (sds[type] <= 0 || lag_squares[type] <= 0) continue;
-    numerator += lag_products[type] / (sds[type] * sds[type]);
-    denominator += lag_squares[type] / (sds[type] * sds[type]);
-  }
-  if (denominator > 0) seen.correlation = numerator / denominator;
+  PooledAutocorrelation(lag_products, lag_squares, {seen.rotation_sd, seen.translation_sd},
+                        &seen.acf);
   seen.rate = at_risk > 0 ? static_cast<double>(starts) / static_cast<double>(at_risk) : 0.0;
   if (ends > 0) seen.mean_frames = static_cast<double>(spike_frames) / static_cast<double>(ends);
   if (spike_frames > 0) {
@@ -642,8 +795,10 @@ PooledSpikes SimulatedMoments(const PooledSpikes& model, const GrossThresholds& 
 }
 
 // The model whose simulated moments are `measured`: a fixed-point iteration from `start`, sds
-// scaled by measured / simulated, the correlation, rate and length moved by measured − simulated
-// (rate ≥ 0, length ≥ 1), until nothing moves by more than 1e-3 of its measured value (at most
+// scaled by measured / simulated, the rate and length moved by measured − simulated (rate ≥ 0,
+// length ≥ 1), the time scales refitted (FitTimeScales) to their own autocorrelation moved by
+// measured − simulated at every lag, until nothing moves by more than 1e-3 of its measured value
+// (the autocorrelation: 1e-3 at any lag; at most
 // max_iterations: the simulated moments are step functions of the rate and length, so the last
 // steps need not settle; the simulation's own sampling error is larger). What moves: `Fitted`.
 enum class Fitted { kCore, kCoreAndSpikes, kEpisodes };
@@ -669,7 +824,13 @@ PooledSpikes FitToMoments(const PooledSpikes& measured, const PooledSpikes& star
     if (fitted != Fitted::kEpisodes) {
       scale(&model.rotation_sd, measured.rotation_sd, seen.rotation_sd);
       scale(&model.translation_sd, measured.translation_sd, seen.translation_sd);
-      shift(&model.correlation, measured.correlation, seen.correlation, 0.0, 0.999, 1.0);
+      // The time scales whose own autocorrelation is moved by measured − simulated at every lag.
+      const Autocorrelation now = ModelAutocorrelation(model.Scales());
+      Autocorrelation target;
+      for (int k = 0; k < kCoreLags; ++k) target[k] = now[k] + measured.acf[k] - seen.acf[k];
+      model.SetScales(FitTimeScales(target));
+      const Autocorrelation next = ModelAutocorrelation(model.Scales());
+      for (int k = 0; k < kCoreLags; ++k) change = std::max(change, std::abs(next[k] - now[k]));
     }
     if (fitted == Fitted::kCoreAndSpikes) {
       scale(&model.spike_rotation_sd, measured.spike_rotation_sd, seen.spike_rotation_sd);
@@ -700,7 +861,8 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
   PooledSpikes measured;
   measured.rotation_sd = fit.rotation_sd;
   measured.translation_sd = fit.translation_sd;
-  measured.correlation = fit.correlation;
+  measured.SetScales({fit.slow_share, fit.slow_correlation, fit.correlation});
+  measured.acf = estimate->core_autocorrelation;
   measured.rate = static_cast<double>(runs.Total(runs.starts)) / static_cast<double>(at_risk);
   measured.mean_frames = ends > 0 ? static_cast<double>(runs.Total(runs.frames)) /
                                         static_cast<double>(ends)
@@ -748,6 +910,8 @@ void CorrectBySimulation(const PoseErrorSums& sums, const GrossThresholds& gross
   fit.rotation_sd = model.rotation_sd;
   fit.translation_sd = model.translation_sd;
   fit.correlation = model.correlation;
+  fit.slow_share = model.slow_share;
+  fit.slow_correlation = model.slow_correlation;
   if (spikes) {
     fit.spike_rotation_sd = model.spike_rotation_sd;
     fit.spike_translation_sd = model.spike_translation_sd;

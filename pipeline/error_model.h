@@ -6,14 +6,24 @@
 //
 // Pose error of frame t: tracked_t = truth_t * proxy_T_error_t, proxy_T_error_t =
 // (Exp(r_t), e_t) with r_t (rotation vector [rad]) and e_t (translation [m]) in the proxy frame,
-// each of the six components an independent stationary AR(1) process
-//   x_{t+1} = ρ x_t + sqrt(1 − ρ²) σ n_t,  n_t ~ N(0, 1),  x_0 ~ N(0, σ²),
-// so that Var x_t = σ² and Corr(x_t, x_{t+1}) = ρ. On top of that, three kinds of episode, drawn
+// each of the six components an independent sum of two stationary AR(1) processes, a slow drift
+// holding the share w of the variance and a fast jitter holding the rest:
+//   x_t = s_t + f_t,  s_{t+1} = ρ_s s_t + sqrt(1 − ρ_s²) sqrt(w) σ n_t,
+//                     f_{t+1} = ρ_f f_t + sqrt(1 − ρ_f²) sqrt(1 − w) σ m_t,  n_t, m_t ~ N(0, 1),
+// started stationary, so that Var x_t = σ² and Corr(x_t, x_{t+k}) = w ρ_s^k + (1 − w) ρ_f^k. (The
+// tracker's error is not one AR(1): on the full-fidelity study its autocorrelation falls from
+// 0.5 at lag 1 to 0.3 at lag 2 and then stays near 0.2-0.3 for 8 frames; docs/study.md, "The
+// core's two time scales".) With w = 0 it is the single AR(1) x_{t+1} = ρ_f x_t + ... of earlier
+// versions, with the same draws. On top of that, three kinds of episode, drawn
 // in this order on the frames the earlier kinds left:
-//   losses  the frames are reported lost (the last reported pose held);
 //   flips   the tracker holds the proxy's near-symmetric twin: the pose turned by flip_rotation
 //           about the table's vertical and moved by flip_translation in a horizontal direction
-//           (both fixed per episode; the Soldier seen side-on, tracked the wrong way round);
+//           (both fixed per episode; the Soldier seen side-on, tracked the wrong way round). The
+//           tracker loses the proxy and finds the twin again in the course of one: each of its
+//           frames is reported lost with probability flip_lost_share (on the full-fidelity study
+//           192 of 244 runs of twin frames began after a lost frame, most of them inside one
+//           longer episode; counted apart, each fragment would be a new twin with a new offset);
+//   losses  the frames are reported lost (the last reported pose held; the run fills them in);
 //   spikes  a short wrong fit: an error rotation vector and translation drawn per episode
 //           (N(0, spike_rotation_sd²) and N(0, spike_translation_sd²) per axis, proxy frame),
 //           added to the AR(1) error.
@@ -103,10 +113,14 @@ struct ErrorModelOptions {
   // success criterion.
   double translation_sd = measured::kTranslationSd;  // σ_e [m]
   double rotation_sd = measured::kRotationSd;        // σ_r [rad]
-  double correlation = measured::kCorrelation;       // ρ, lag one, in [0, 1)
+  double correlation = measured::kCorrelation;       // ρ_f, the jitter's lag one, in [0, 1)
+  double slow_share = measured::kSlowShare;          // w, the drift's share of σ², in [0, 1]
+  double slow_correlation = measured::kSlowCorrelation;  // ρ_s, the drift's lag one, in [0, 1)
   // Flips (see above): rotation [rad] and translation [m] of the twin.
   double flip_rotation = measured::kFlipRotation;
   double flip_translation = measured::kFlipTranslation;
+  // The share of a flip's frames reported lost, in [0, 1).
+  double flip_lost_share = measured::kFlipLostShare;
   // Spikes (see above): per-axis sizes [rad], [m].
   double spike_rotation_sd = measured::kSpikeRotationSd;
   double spike_translation_sd = measured::kSpikeTranslationSd;
@@ -126,8 +140,11 @@ struct ErrorModelOptions {
     v("translation_sd", translation_sd);
     v("rotation_sd", rotation_sd);
     v("correlation", correlation);
+    v("slow_share", slow_share);
+    v("slow_correlation", slow_correlation);
     v("flip_rotation", flip_rotation);
     v("flip_translation", flip_translation);
+    v("flip_lost_share", flip_lost_share);
     v("spike_rotation_sd", spike_rotation_sd);
     v("spike_translation_sd", spike_translation_sd);
     v("lying_tilt_deg", lying_tilt_deg);
@@ -169,6 +186,9 @@ SimulatedReading SimulateSliderReading(const Annotation& truth, const ErrorModel
 
 // ---- Measuring the model on full-fidelity runs -------------------------------------------------
 
+// The lags of the core's autocorrelation that the fit matches (1 .. kCoreLags frames).
+inline constexpr int kCoreLags = 8;
+
 struct ErrorModelEstimate {
   ErrorModelOptions options;  // the fitted model (fields without data keep `prior`'s values)
   // The moments as measured, before the correction by simulation (see EstimateErrorModel).
@@ -176,6 +196,9 @@ struct ErrorModelEstimate {
   // The correction: the fitted core's own excursion starts per frame at risk, the share of the
   // fitted spike episodes that the moments see, and the iterations it took.
   double core_excursion_rate = 0.0;
+  // The inliers' autocorrelation at lags 1 .. kCoreLags as measured (pooled over the six
+  // components, each type scaled by its variance; pairs of inlier frames k apart in one take).
+  std::array<double, kCoreLags> core_autocorrelation{};
   double spike_visibility = 1.0;
   int simulation_iterations = 0;
   // Whether the correction was applied: not with fewer than 100 spike episodes, nor where the
@@ -185,9 +208,10 @@ struct ErrorModelEstimate {
   std::int64_t frames = 0;    // tracked frames observed
   std::array<std::int64_t, kViewConditions> condition_frames{};  // of them, per view condition
   std::int64_t inlier_frames = 0;
-  std::int64_t flip_frames = 0;
+  std::int64_t flip_frames = 0;       // frames in flip episodes (twin or lost)
+  std::int64_t flip_lost_frames = 0;  // of them, lost
   std::int64_t spike_frames = 0;
-  std::int64_t lost_frames = 0;
+  std::int64_t lost_frames = 0;       // lost frames outside flip episodes
   int flip_episodes = 0;
   int spike_episodes = 0;
   int loss_episodes = 0;
@@ -202,13 +226,15 @@ struct ErrorModelEstimate {
 };
 
 // Fits the model by moments. Frames within gross_threshold_deg and gross_threshold_m (the
-// tracker's success criterion) are inliers: σ is the per-axis RMS and ρ the pooled lag-one
-// autocorrelation of their error components over consecutive inlier frames. Frames beyond it with
-// a rotation error above 90° are flips, the others spikes; flip, spike and loss episodes are runs
-// of consecutive such frames: rate = episodes / frames at risk (the frames not in an episode of
-// that kind or an earlier one), mean = frames / episodes; flip_rotation and flip_translation are
-// the mean error angle and distance over flip frames, the spike sizes the per-axis RMS over spike
-// frames. Per view condition (ViewCondition of the true pose, with prior.lying_tilt_deg): the start
+// tracker's success criterion) are inliers: σ is the per-axis RMS, and w, ρ_s and ρ_f those whose
+// autocorrelation w ρ_s^k + (1 − w) ρ_f^k is nearest (least squares, ρ on a grid of 0.001) to the
+// inliers' pooled autocorrelation at lags k = 1 .. kCoreLags (pairs of inlier frames k apart in a
+// take). Frames beyond it with a rotation error above 90° are twin frames, the others spikes. A
+// flip episode is a run of twin and lost frames with at least one twin frame, flip_lost_share its
+// lost frames' share; loss episodes are runs of lost frames outside them, spike episodes runs of
+// spike frames: rate = episodes / frames at risk (the frames not in an episode of that kind or an
+// earlier one), mean = frames / episodes; flip_rotation and flip_translation are the mean error
+// angle and distance over twin frames, the spike sizes the per-axis RMS over spike frames. Per view condition (ViewCondition of the true pose, with prior.lying_tilt_deg): the start
 // rate = episodes starting in it / its frames free at the time (not in an episode of that kind or
 // an earlier one), the mean length = its episode frames / the episodes ending after one of them
 // (the Markov chain's maximum-likelihood hazards); a condition without frames keeps `prior`'s. The
@@ -217,10 +243,11 @@ struct ErrorModelEstimate {
 // These moments (`moments`) are biased wherever the thresholds cut the model's own processes: the
 // core noise goes past them by itself (with σ = 0.026 rad on about 1 % of frames), which they
 // count as spikes; spikes smaller than the thresholds count as core noise and are missed as
-// spikes; the core's RMS is taken over frames cut at the thresholds. So the core (σ, ρ), the
-// spikes' sizes and their pooled rate and mean length are corrected by simulation (indirect
+// spikes; the core's RMS is taken over frames cut at the thresholds. So the core (σ, w, ρ_s, ρ_f),
+// the spikes' sizes and their pooled rate and mean length are corrected by simulation (indirect
 // inference): they are the model whose simulated frames (the core and spikes of SimulateTracking,
-// one view condition, from fixed seeds) give the measured pooled moments. The rate per view
+// one view condition, from fixed seeds) give the measured pooled moments (for the core's time
+// scales: its autocorrelation at lags 1 .. kCoreLags). The rate per view
 // condition is then (measured rate − the core's own excursion rate) / the spikes' visibility
 // (the share of spike episodes the moments see), the length the measured one times the pooled
 // correction. Losses, flips and the slider keep their moments. With fewer than 100 spike episodes,
