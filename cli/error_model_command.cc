@@ -1,5 +1,5 @@
 // `mmh error-model`: the fast mode's error model (pipeline/error_model.h) fitted from a per-frame
-// table of tracked takes (pipeline/tracking_frames.h; a full-fidelity study's tracking_frames.csv),
+// table of tracked takes (pipeline/tracking_frames.h; a full-fidelity study's tracking_errors.csv),
 // so that a change to the estimator is refitted without running the study again.
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -76,9 +76,9 @@ void AddErrorModelCommand(CLI::App& app, const std::vector<std::string>& argv) {
   CLI::App* cmd = app.add_subcommand(
       "error-model",
       "Fit the fast mode's error model from a per-frame table of tracked takes (a full-fidelity "
-      "study's tracking_frames.csv)");
+      "study's tracking_errors.csv)");
   cmd->add_option("--frames", args->frames,
-                  "Per-frame table: tracking_frames.csv of `mmh study` at full fidelity")
+                  "Per-frame table: tracking_errors.csv of `mmh study` at full fidelity")
       ->required();
   AddCommonFlags(cmd, &args->common,
                  {.config_help = "JSON config with an 'error_model' section (the prior)"});

@@ -259,7 +259,7 @@ ErrorModelEstimate EstimateErrorModel(const std::vector<TrackingObservation>& tr
                                       double gross_threshold_deg = 5.0,
                                       double gross_threshold_m = 0.01);
 // The same fit from the per-frame table (pipeline/tracking_frames.h; a study's
-// tracking_frames.csv): the tracking of every take, the slider of the takes that have one. Gives
+// tracking_errors.csv): the tracking of every take, the slider of the takes that have one. Gives
 // the bytes of the fit above on the observations the table was measured from.
 ErrorModelEstimate EstimateErrorModel(const std::vector<TakeFrames>& takes,
                                       const ErrorModelOptions& prior = {},

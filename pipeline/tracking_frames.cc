@@ -146,7 +146,7 @@ std::vector<TakeFrames> ReadTakeFramesCsv(const std::filesystem::path& path) {
     if (!header_seen) {
       if (row != kHeader) {
         throw InputError(where + ": the header is '" + std::string(row.substr(0, 200)) +
-                         "', expected '" + kHeader + "' (a study's tracking_frames.csv)");
+                         "', expected '" + kHeader + "' (a study's tracking_errors.csv)");
       }
       header_seen = true;
       continue;

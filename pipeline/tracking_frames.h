@@ -1,7 +1,7 @@
 // The per-frame table of tracked takes against their ground truth: for every frame, how the true
 // pose was seen and moved, what the tracker reported and how far off it was, and what the slider
 // reader read. It is what the fast mode's error model is measured on (EstimateErrorModel in
-// pipeline/error_model.h): a full-fidelity study writes it as tracking_frames.csv, so that the
+// pipeline/error_model.h): a full-fidelity study writes it as tracking_errors.csv, so that the
 // model can be refitted (`mmh error-model --frames FILE`) and its errors plotted without running
 // the study again.
 #pragma once

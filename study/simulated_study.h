@@ -100,7 +100,7 @@ struct SimulatedStudy {
   ScoringDesign design;
   StudyData data;
   StudyAnalysis analysis;
-  // Full fidelity: every tracked frame against its truth (tracking_frames.csv), and the error model
+  // Full fidelity: every tracked frame against its truth (tracking_errors.csv), and the error model
   // measured on them.
   std::vector<pipeline::TakeFrames> tracking_frames;
   std::optional<pipeline::ErrorModelEstimate> measured_error_model;

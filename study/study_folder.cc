@@ -185,7 +185,7 @@ void WriteStudyFolder(const std::filesystem::path& out_dir, const StudyConfig& c
     WriteFileAtomically(out / "power.csv", PowerCsv(r.power));
   }
   if (!s.tracking_frames.empty()) {
-    WriteFileAtomically(out / "tracking_frames.csv", pipeline::TakeFramesCsv(s.tracking_frames));
+    WriteFileAtomically(out / "tracking_errors.csv", pipeline::TakeFramesCsv(s.tracking_frames));
   }
   if (s.measured_error_model) {
     // The fit as pipeline/error_model.inc: copying it there makes it the fast mode's defaults.

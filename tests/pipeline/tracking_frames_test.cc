@@ -128,7 +128,7 @@ TEST(TrackingFramesTest, TheCsvReadsBackToTheSameDoublesAndTheSameFit) {
     }
   }
   test_util::TempDir dir;
-  const auto path = dir / "tracking_frames.csv";
+  const auto path = dir / "tracking_errors.csv";
   test_util::WriteText(path, TakeFramesCsv(frames));
   const std::vector<TakeFrames> again = ReadTakeFramesCsv(path);
   ASSERT_EQ(again.size(), frames.size());

@@ -52,11 +52,11 @@ TEST(StudyCliTest, FullFidelityWritesTheErrorModelFit) {
   EXPECT_LT(translation_sd, 1e-2);
   EXPECT_NE(fit.find("inline constexpr ViewRates kView"), std::string::npos);
 
-  // Every tracked frame is in tracking_frames.csv (and a header), and `mmh error-model` fitted on
+  // Every tracked frame is in tracking_errors.csv (and a header), and `mmh error-model` fitted on
   // it gives the study's fit, number for number.
-  const std::string frames = ReadBytes(out / "tracking_frames.csv");
+  const std::string frames = ReadBytes(out / "tracking_errors.csv");
   EXPECT_EQ(std::count(frames.begin(), frames.end(), '\n'), 549 + 1);
-  const auto refit = RunMmh("error-model --frames " + (out / "tracking_frames.csv").string() +
+  const auto refit = RunMmh("error-model --frames " + (out / "tracking_errors.csv").string() +
                             " --quiet --out " + (dir / "refit").string());
   ASSERT_EQ(refit.exit_code, 0) << refit.output;
   const auto results = nlohmann::json::parse(ReadBytes(out / "results.json"));
