@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "cli/provenance.h"
 #include "core/config.h"
 #include "core/duration_text.h"
 
@@ -32,6 +33,9 @@ void AddCommonFlags(CLI::App* command, CommonFlags* flags, const CommonFlagsSpec
 }
 
 Config LoadConfig(const CommonFlags& common) {
+  // run.json's git_commit is the commit checked out when the command starts: asked at the end, a
+  // 45-minute study named a commit made while it ran.
+  StartGitCommitLookup();
   Config config;
   if (!common.config_file.empty()) config = Config::Load(common.config_file);
   for (const auto& set : common.sets) config.Set(set);
