@@ -12,9 +12,9 @@
 //                     f_{t+1} = ρ_f f_t + sqrt(1 − ρ_f²) sqrt(1 − w) σ m_t,  n_t, m_t ~ N(0, 1),
 // started stationary, so that Var x_t = σ² and Corr(x_t, x_{t+k}) = w ρ_s^k + (1 − w) ρ_f^k. (The
 // tracker's error is not one AR(1): on the full-fidelity study its autocorrelation falls from
-// 0.5 at lag 1 to 0.3 at lag 2 and then stays near 0.2-0.3 for 8 frames; docs/study.md, "The
-// core's two time scales".) With w = 0 it is the single AR(1) x_{t+1} = ρ_f x_t + ... of earlier
-// versions, with the same draws. On top of that, three kinds of episode, drawn
+// 0.5 at lag 1 to 0.37 at lag 2 and is still 0.23 at lag 8; docs/study.md, "The core's two time
+// scales and flips through their losses".) With w = 0 it is the single AR(1) of earlier versions,
+// x_{t+1} = ρ_f x_t + ..., with the same draws. On top of that, three kinds of episode, drawn
 // in this order on the frames the earlier kinds left:
 //   flips   the tracker holds the proxy's near-symmetric twin: the pose turned by flip_rotation
 //           about the table's vertical and moved by flip_translation in a horizontal direction
