@@ -12,6 +12,7 @@
 #include "cli/provenance.h"
 #include "core/atomic_file.h"
 #include "core/config.h"
+#include "core/error.h"
 #include "pipeline/error_model.h"
 #include "pipeline/tracking_frames.h"
 
@@ -39,6 +40,10 @@ void RunErrorModel(const ErrorModelArgs& args, const std::vector<std::string>& a
 
   // Everything is read and fitted before anything is written: bad input leaves no output.
   const std::vector<pipeline::TakeFrames> takes = pipeline::ReadTakeFramesCsv(args.frames);
+  if (takes.empty()) {
+    throw InputError(args.frames + ": no frames after the header, expected the tracked frames of "
+                     "at least one take (nothing to fit)");
+  }
   const double read_seconds = SecondsSince(start);
   const auto fit_start = std::chrono::steady_clock::now();
   const pipeline::ErrorModelEstimate estimate = pipeline::EstimateErrorModel(takes, prior);

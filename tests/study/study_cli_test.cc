@@ -72,6 +72,14 @@ TEST(StudyCliTest, FullFidelityWritesTheErrorModelFit) {
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("bad.csv:2: 4 fields, expected 18"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad" / "error_model.inc"));
+  // A table with its header only: nothing to fit, an error rather than the prior.
+  test_util::WriteText(dir / "empty.csv", frames.substr(0, frames.find('\n') + 1));
+  const auto empty = RunMmh("error-model --frames " + (dir / "empty.csv").string() + " --out " +
+                            (dir / "empty").string());
+  EXPECT_EQ(empty.exit_code, 2) << empty.output;
+  EXPECT_NE(empty.output.find("empty.csv: no frames after the header"), std::string::npos)
+      << empty.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "empty" / "error_model.inc"));
 }
 
 TEST(StudyCliTest, WritesEverythingAndStatsReproducesIt) {
