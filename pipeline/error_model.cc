@@ -503,24 +503,18 @@ void AddTracking(const TakeFrames& take, const ErrorModelOptions& prior,
   }
   estimate->frames += static_cast<std::int64_t>(n);
   // Flip episodes: the runs of twin and lost frames that hold a twin frame.
-  std::vector<bool> in_flip(n, false), other_lost(n, false);
-  for (std::size_t t = 0; t < n;) {
-    if (!(lost[t] || flip[t])) {
-      ++t;
-      continue;
-    }
-    std::size_t end = t;
-    bool twin = false;
-    while (end < n && (lost[end] || flip[end])) twin = twin || flip[end], ++end;
-    for (std::size_t u = t; u < end; ++u) {
-      in_flip[u] = twin;
-      other_lost[u] = !twin;
-      if (twin && lost[u]) ++sums->flip_lost_frames;
-      if (flip[u]) ++sums->twin_frames;
-    }
-    t = end;
-  }
   for (std::size_t t = 0; t < n; ++t) lost_or_flip[t] = lost[t] || flip[t];
+  std::vector<bool> in_flip(n, false), other_lost(n, false);
+  for (std::size_t t = 0, end = 0; t < n; t = std::max(end, t + 1)) {
+    for (end = t; end < n && lost_or_flip[end]; ++end) {}
+    const bool twin = std::find(flip.begin() + t, flip.begin() + end, true) != flip.begin() + end;
+    for (std::size_t u = t; u < end; ++u) in_flip[u] = twin;
+  }
+  for (std::size_t t = 0; t < n; ++t) {
+    other_lost[t] = lost[t] && !in_flip[t];
+    if (in_flip[t] && lost[t]) ++sums->flip_lost_frames;
+    if (flip[t]) ++sums->twin_frames;
+  }
   CountRuns(in_flip, std::vector<bool>(n, false), condition, &sums->flip_runs);
   CountRuns(other_lost, in_flip, condition, &sums->loss_runs);
   CountRuns(spike, lost_or_flip, condition, &sums->spike_runs);
