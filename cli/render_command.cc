@@ -61,6 +61,9 @@ struct SensorCheckArgs {
   CommonFlags common;
   std::string data;
   std::string sequence;
+  // Like for like (docs/sensor.md): the sequence's first frame beside the same view rendered.
+  std::string view, view_model, view_trajectory, view_label;
+  int view_object = 8;
   int frames = 3;
 };
 
@@ -77,8 +80,21 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   if (!args.sequence.empty()) {
     sequence = pipeline::ReadDepthSequence(args.sequence, std::end(sim::kTemporalLags)[-1] + 1);
   }
+  std::optional<sim::RealView> view;
+  if (!args.view.empty()) {
+    if (args.sequence.empty()) {
+      ThrowBadValue("--view", "\"" + args.view + "\"", "a --sequence whose first frame it shows");
+    }
+    std::string trajectory = args.view_trajectory;
+    if (trajectory.empty()) {
+      trajectory = std::filesystem::path(args.view).replace_extension(".tum").string();
+    }
+    view = pipeline::ReadRealView(args.sequence, args.view_label, args.view_object, args.view,
+                                  args.view_model, trajectory);
+  }
   const sim::SensorCheckReport report =
-      sim::RunSensorCheck(args.data, render, args.frames, sequence ? &*sequence : nullptr);
+      sim::RunSensorCheck(args.data, render, args.frames, sequence ? &*sequence : nullptr,
+                          view ? &*view : nullptr);
   std::cout << report.Format();
   if (!args.common.out_dir.empty()) {
     const std::filesystem::path out = args.common.out_dir;
@@ -119,6 +135,25 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
   cmd->add_option("--sequence", args->sequence,
                   "Real recording (BOP, YCB-Video or TUM folder) of a nearly static view: the "
                   "temporal structure of its errors; empty: none")
+      ->capture_default_str();
+  // The same view rendered (tests/data/real/ycbv/views, render_real_view.py): the gelatin box of
+  // video 0000 where its truth puts it, seen from where the real camera stood.
+  const std::string ycbv = std::string(MMH_SOURCE_DIR) + "/tests/data/real/ycbv";
+  args->view = ycbv + "/views/009_gelatin_box_static.json";
+  args->view_model = ycbv + "/models_real/009_gelatin_box.obj";
+  args->view_label = ycbv + "/data/0000/000001-label.png";
+  cmd->add_option("--view", args->view,
+                  "Render config of the --sequence's view (camera and object placed as in its "
+                  "first frame) for the like-for-like comparison; empty: none")
+      ->capture_default_str();
+  cmd->add_option("--view-model", args->view_model, "The object's model (the view's proxy)")
+      ->capture_default_str();
+  cmd->add_option("--view-trajectory", args->view_trajectory,
+                  "The object's poses (TUM, table frame); empty: --view with the extension .tum");
+  cmd->add_option("--view-label", args->view_label,
+                  "Label image of the sequence's first frame (8-bit, YCB-Video -label.png)")
+      ->capture_default_str();
+  cmd->add_option("--view-object", args->view_object, "The object's value in the label image")
       ->capture_default_str();
   cmd->add_option("--frames", args->frames, "Rendered frames to analyse")
       ->check(CLI::Range(1, 1000));

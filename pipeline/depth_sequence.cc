@@ -1,8 +1,11 @@
 #include "pipeline/depth_sequence.h"
 
+#include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/config.h"
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/rgbd_frame.h"
 #include "track/recording.h"
 
@@ -38,6 +41,41 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
     sequence.depth_m.push_back(std::move(depth_m));
   }
   return sequence;
+}
+
+sim::RealView ReadRealView(const std::filesystem::path& folder, const std::filesystem::path& label,
+                           int object, const std::filesystem::path& view,
+                           const std::filesystem::path& model,
+                           const std::filesystem::path& trajectory) {
+  sim::DepthSequence first = ReadDepthSequence(folder, 1);
+  sim::RealView real;
+  real.name = first.name + " frame 1";
+  real.width = first.width;
+  real.height = first.height;
+  real.intrinsics = first.intrinsics;
+  real.depth_m = std::move(first.depth_m.front());
+  const RgbImage labels = ReadRgbImage(label);
+  if (labels.width != real.width || labels.height != real.height) {
+    ThrowBadValue(label.string() + ": size",
+                  std::to_string(labels.width) + "x" + std::to_string(labels.height),
+                  "the depth frame's " + std::to_string(real.width) + "x" +
+                      std::to_string(real.height));
+  }
+  real.mask.assign(real.depth_m.size(), 0);
+  size_t pixels = 0;
+  for (size_t p = 0; p < real.mask.size(); ++p) {
+    real.mask[p] = labels.rgb[3 * p] == object;
+    pixels += real.mask[p];
+  }
+  if (pixels == 0) {
+    ThrowBadValue(label.string() + ": object", std::to_string(object),
+                  "a label the image holds");
+  }
+  Config config = Config::Load(view);
+  config.Set("render.proxy=" + nlohmann::json(model.string()).dump());
+  config.Set("render.trajectory=" + nlohmann::json(trajectory.string()).dump());
+  real.config = sim::RenderConfig::FromConfig(config);
+  return real;
 }
 
 }  // namespace mmh::pipeline

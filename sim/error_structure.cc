@@ -165,6 +165,65 @@ std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int
   return classes;
 }
 
+NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
+                                            int height, std::span<const uint8_t> mask,
+                                            int radius_px, const ErrorStructureOptions& options) {
+  const size_t pixels = static_cast<size_t>(width) * height;
+  if (depth_m.size() != pixels || mask.size() != pixels) {
+    ThrowBadValue("mask", std::to_string(mask.size()) + " pixels and " +
+                              std::to_string(depth_m.size()) + " depths",
+                  std::to_string(pixels) + " of each");
+  }
+  if (radius_px < 0) ThrowBadValue("radius_px", std::to_string(radius_px), "0 or more");
+  // Grow the mask: along rows, then along columns (a square of side 2 radius + 1).
+  std::vector<uint8_t> rows(pixels, 0), region(pixels, 0);
+  for (int v = 0; v < height; ++v) {
+    int last = std::numeric_limits<int>::min() / 2;  // the last object pixel at or left of u
+    for (int u = 0; u < width + radius_px; ++u) {
+      if (u < width && mask[static_cast<size_t>(v) * width + u] != 0) last = u;
+      const int target = u - radius_px;
+      if (target >= 0 && u - last <= 2 * radius_px) rows[static_cast<size_t>(v) * width + target] = 1;
+    }
+  }
+  for (int u = 0; u < width; ++u) {
+    int last = std::numeric_limits<int>::min() / 2;
+    for (int v = 0; v < height + radius_px; ++v) {
+      if (v < height && rows[static_cast<size_t>(v) * width + u] != 0) last = v;
+      const int target = v - radius_px;
+      if (target >= 0 && v - last <= 2 * radius_px) region[static_cast<size_t>(target) * width + u] = 1;
+    }
+  }
+  NeighbourhoodStructure n;
+  double missing = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    if (region[p] == 0) continue;
+    n.pixels += 1;
+    if (!ValidDepth(depth_m[p])) missing += 1;
+  }
+  n.missing_share = n.pixels > 0 ? missing / n.pixels : kNaN;
+  // ClassifyMissing gives every pixel of a run its run's class, and runs are separated by valid
+  // pixels, so a run is a maximal stretch of one missing class.
+  const std::vector<MissingClass> classes = ClassifyMissing(depth_m, width, height, options);
+  std::vector<double> shadow_runs, edge_runs;
+  for (int v = 0; v < height; ++v) {
+    const size_t row = static_cast<size_t>(v) * width;
+    for (int u = 0; u < width;) {
+      const MissingClass c = classes[row + u];
+      const int first = u;
+      bool touches = false;
+      while (u < width && classes[row + u] == c) touches |= region[row + u++] != 0;
+      if (!touches) continue;
+      if (c == MissingClass::kShadow) shadow_runs.push_back(u - first);
+      if (c == MissingClass::kEdge) edge_runs.push_back(u - first);
+    }
+  }
+  n.shadow_runs = static_cast<int>(shadow_runs.size());
+  n.edge_runs = static_cast<int>(edge_runs.size());
+  n.shadow_band_px = Median(shadow_runs);
+  n.edge_band_px = Median(edge_runs);
+  return n;
+}
+
 std::string FormatCauseTable(const std::vector<MissingClass>& classes,
                              std::span<const MissingCause> causes) {
   constexpr const char* kClassNames[] = {"valid", "border", "shadow",

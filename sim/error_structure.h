@@ -105,6 +105,24 @@ std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int
                                           std::vector<double>* shadow_runs = nullptr,
                                           std::vector<double>* edge_runs = nullptr);
 
+// Missing pixels around one object (issue 23's "comparable table-top scene": a real frame and
+// the same view rendered, the same object seen from the same place). The neighbourhood is the
+// object's mask (width x height, non-zero = object) grown by `radius_px` pixels (a square,
+// Chebyshev distance); missing_share is the share of its pixels that are missing, and the band
+// widths are the medians of the ClassifyMissing shadow and edge runs with a pixel in it. Lengths
+// and radius are in this frame's pixels; compare frames of different focal lengths at radii in
+// the same proportion and with the bands scaled by that proportion.
+struct NeighbourhoodStructure {
+  double pixels = 0;         // in the neighbourhood
+  double missing_share = 0;  // of them
+  double shadow_band_px = 0, edge_band_px = 0;  // NaN: no run
+  int shadow_runs = 0, edge_runs = 0;
+};
+NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
+                                            int height, std::span<const uint8_t> mask,
+                                            int radius_px,
+                                            const ErrorStructureOptions& options = {});
+
 // The classes against a rendered frame's exact causes (KinectSensor::missing_causes), in % of all
 // pixels: how well the depth-image rules that classify real frames name the sensor's causes.
 std::string FormatCauseTable(const std::vector<MissingClass>& classes,

@@ -7,6 +7,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/tum_io.h"
 #include "sim/kinect_sensor.h"
 
 namespace mmh::sim {
@@ -77,12 +78,76 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
   return report.rendered_frames[first];
 }
 
+// The real view rendered in both modes, and each frame's neighbourhood of the object beside the
+// real frame's (docs/sensor.md, "Like for like").
+void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
+  const RenderConfig& config = view.config;
+  if (config.render.trajectory.empty()) {
+    ThrowBadValue(view.name + ": render.trajectory", "\"\"",
+                  "the object's poses, the first the real frame's");
+  }
+  const Rigid3 table_T_object = ReadTum(config.render.trajectory).poses.at(0);
+  TableTopScene scene(config, LoadProxyModel(config.render.proxy, config.render.proxy_scale));
+  // The object's mask: where the exact depth with the object is valid and nearer than without it
+  // (the object moved far below the floor).
+  KinectSensorOptions exact = config.sensor;
+  exact.mode = SensorMode::kStatistical;
+  exact.noise = false;
+  auto exact_depth = [&](const Rigid3& pose) {
+    scene.SetFrame(pose, 0.0);
+    KinectSensor sensor(exact, &scene.scene(), scene.table_T_camera());
+    const RgbdFrame frame = sensor.Render(0);
+    return std::make_pair(DepthMetresFromUnits(frame.depth, frame.depth_scale),
+                          frame.depth_intrinsics);
+  };
+  const auto [without, intrinsics] =
+      exact_depth(Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, -100)));
+  const auto with = exact_depth(table_T_object).first;
+  std::vector<uint8_t> mask(with.size(), 0);
+  for (size_t p = 0; p < with.size(); ++p) {
+    mask[p] = with[p] > 0 && (!(without[p] > 0) || with[p] < without[p] - 0.005f);
+  }
+  const double focal = intrinsics.fx;
+  const int width = intrinsics.width, height = intrinsics.height;
+  if (!(view.intrinsics.fx > 0) || view.mask.size() != view.depth_m.size() ||
+      view.depth_m.size() != static_cast<size_t>(view.width) * view.height) {
+    ThrowBadValue(view.name + ": real frame", std::to_string(view.width) + "x" +
+                                                  std::to_string(view.height) + ", " +
+                                                  std::to_string(view.mask.size()) + " mask pixels",
+                  "a depth image, its intrinsics and a mask of the same size");
+  }
+  const double real_scale = focal / view.intrinsics.fx;
+  report.like_for_like.push_back(
+      {view.name, real_scale,
+       AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask,
+                            static_cast<int>(std::lround(kNeighbourhoodRadiusPx / real_scale)))});
+  report.view_depth_m[0] = view.depth_m;
+  report.view_width = view.width;
+  report.view_height = view.height;
+  scene.SetFrame(table_T_object, 0.0);
+  for (const SensorMode mode : {SensorMode::kStatistical, SensorMode::kStructuredLight}) {
+    KinectSensorOptions options = config.sensor;
+    options.mode = mode;
+    KinectSensor sensor(options, &scene.scene(), scene.table_T_camera());
+    const RgbdFrame frame = sensor.Render(0);
+    const bool structured = mode == SensorMode::kStructuredLight;
+    std::vector<float> depth_m = DepthMetresFromUnits(frame.depth, frame.depth_scale);
+    report.like_for_like.push_back(
+        {structured ? "view, SL" : "view, stat.", 1.0,
+         AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx)});
+    report.view_depth_m[structured ? 2 : 1] = std::move(depth_m);
+  }
+  if (width != view.width || height != view.height) report.view_width = 0;  // no picture
+}
+
 }  // namespace
 
 SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
                                  const RenderConfig& config, int frames,
-                                 const DepthSequence* real_sequence) {
+                                 const DepthSequence* real_sequence,
+                                 const RealView* real_view) {
   SensorCheckReport report;
+  if (real_view != nullptr) CompareLikeForLike(*real_view, report);
   if (real_sequence != nullptr) {
     report.temporal.push_back(TemporalStructure(real_sequence->name, *real_sequence));
   }
@@ -140,7 +205,51 @@ std::string SensorCheckReport::Format() const {
     }
     text += "\n";
   }
+  if (!like_for_like.empty()) text += FormatLikeForLike();
   return text;
+}
+
+std::string SensorCheckReport::FormatLikeForLike() const {
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "\nlike for like: around the object (its mask grown by %d px), band widths in the "
+                "rendered sensor's pixels\n",
+                kNeighbourhoodRadiusPx);
+  std::string text = line;
+  std::snprintf(line, sizeof(line), "%-24s", "");
+  text += line;
+  for (const NeighbourhoodRow& row : like_for_like) {
+    std::snprintf(line, sizeof(line), "%26s", row.name.c_str());
+    text += line;
+  }
+  text += "     SL/real   goal\n";
+  const NeighbourhoodRow& real = like_for_like.front();
+  const NeighbourhoodRow& sl = like_for_like.back();
+  auto add = [&](const char* label, auto value) {
+    std::snprintf(line, sizeof(line), "%-24s", label);
+    text += line;
+    for (const NeighbourhoodRow& row : like_for_like) {
+      std::snprintf(line, sizeof(line), "%26.2f", value(row));
+      text += line;
+    }
+    std::snprintf(line, sizeof(line), "%12.2f   0.8-1.2\n", value(sl) / value(real));
+    text += line;
+  };
+  add("missing [%]", [](const NeighbourhoodRow& r) { return 100 * r.structure.missing_share; });
+  add("shadow band [px]",
+      [](const NeighbourhoodRow& r) { return r.structure.shadow_band_px * r.pixel_scale; });
+  add("edge band [px]",
+      [](const NeighbourhoodRow& r) { return r.structure.edge_band_px * r.pixel_scale; });
+  std::snprintf(line, sizeof(line), "%-24s", "runs (shadow, edge)");
+  text += line;
+  for (const NeighbourhoodRow& row : like_for_like) {
+    std::snprintf(line, sizeof(line), "%26s",
+                  (std::to_string(row.structure.shadow_runs) + ", " +
+                   std::to_string(row.structure.edge_runs))
+                      .c_str());
+    text += line;
+  }
+  return text + "\n";
 }
 
 nlohmann::json SensorCheckReport::ToJson() const {
@@ -162,10 +271,23 @@ nlohmann::json SensorCheckReport::ToJson() const {
     }
     temporal_json.push_back({{"sequence", row.name}, {"lags", lags}});
   }
+  nlohmann::json like = nlohmann::json::array();
+  for (const NeighbourhoodRow& row : like_for_like) {
+    const NeighbourhoodStructure& n = row.structure;
+    like.push_back({{"frame", row.name},
+                    {"pixel_scale", row.pixel_scale},
+                    {"pixels", n.pixels},
+                    {"missing_share", n.missing_share},
+                    {"shadow_band_px", n.shadow_band_px * row.pixel_scale},
+                    {"edge_band_px", n.edge_band_px * row.pixel_scale},
+                    {"shadow_runs", n.shadow_runs},
+                    {"edge_runs", n.edge_runs}});
+  }
   return {{"columns", j},
           {"rendered_frames", frames},
           {"error_structure", error_structure},
-          {"temporal_correlation", temporal_json}};
+          {"temporal_correlation", temporal_json},
+          {"like_for_like", like}};
 }
 
 void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out) {
@@ -177,6 +299,12 @@ void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::pa
                 DepthSideBySide({&report.tum_depth_m, &report.rendered_depth_m[0],
                                  &report.rendered_depth_m[1]},
                                 report.width, report.height));
+  }
+  if (report.view_width > 0) {
+    WriteRgbPng(out / "sensor_check_view.png",
+                DepthSideBySide({&report.view_depth_m[0], &report.view_depth_m[1],
+                                 &report.view_depth_m[2]},
+                                report.view_width, report.view_height));
   }
 }
 

@@ -25,6 +25,24 @@ struct DepthSequence {
   std::vector<std::vector<float>> depth_m;
 };
 
+// A real frame and the same view rendered (docs/sensor.md, "Like for like"): issue 23's
+// comparable table-top scene. The view's render config places the camera where the real one
+// stood and the object, with its real shape as the proxy, where the truth puts it
+// (tests/data/real/ycbv/views, render_real_view.py); render.trajectory's first pose is the real
+// frame's.
+struct RealView {
+  std::string name;
+  int width = 0, height = 0;
+  PinholeIntrinsics intrinsics;
+  std::vector<float> depth_m;  // the real frame [m], width x height row-major, 0 = missing
+  std::vector<uint8_t> mask;   // the object's pixels in it (its label image), non-zero = object
+  RenderConfig config;
+};
+
+// The neighbourhood of the object compared (AnalyseNeighbourhood): its mask grown by this many
+// pixels at the rendered sensor's focal length (in proportion at the real frame's).
+inline constexpr int kNeighbourhoodRadiusPx = 10;
+
 // Frame lags of the temporal correlation (AnalyseTemporalCorrelation against the first frame).
 inline constexpr int kTemporalLags[] = {1, 4};
 
@@ -51,9 +69,22 @@ struct SensorCheckReport {
     std::vector<TemporalCorrelation> lags;  // one per kTemporalLags
   };
   std::vector<TemporalRow> temporal;
+  // Like for like (when a RealView is given): the real frame, then the view rendered in each mode
+  // (statistical, structured light). pixel_scale turns the row's pixels into the rendered
+  // sensor's (its focal length over the row's).
+  struct NeighbourhoodRow {
+    std::string name;
+    double pixel_scale = 1;
+    NeighbourhoodStructure structure;
+  };
+  std::vector<NeighbourhoodRow> like_for_like;
+  // Their depth images for sensor_check_view.png (real, statistical, structured light).
+  int view_width = 0, view_height = 0;
+  std::vector<float> view_depth_m[3];
 
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
+  std::string FormatLikeForLike() const;
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };
@@ -62,13 +93,16 @@ struct SensorCheckReport {
 // missing or unreadable file) and renders `frames` frames of `config`'s scene (the demo walk) in
 // both sensor modes (at least kTemporalLags.back() + 1 for the temporal structure, which the
 // statistics of frames beyond `frames` do not enter). `real_sequence`: a real recording's first
-// frames for the temporal structure (nullptr: none).
+// frames for the temporal structure (nullptr: none). `real_view`: a real frame and its view to
+// compare like for like (nullptr: none).
 SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
                                  const RenderConfig& config, int frames,
-                                 const DepthSequence* real_sequence = nullptr);
+                                 const DepthSequence* real_sequence = nullptr,
+                                 const RealView* real_view = nullptr);
 
 // Writes sensor_check.json and, when the frames have the same size, sensor_check.png (TUM,
-// statistical, structured light side by side) into `out`.
+// statistical, structured light side by side) into `out`; with a like-for-like comparison also
+// sensor_check_view.png (the real frame, statistical, structured light).
 void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out);
 
 }  // namespace mmh::sim

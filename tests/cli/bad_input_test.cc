@@ -749,6 +749,10 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
        {"plan.json", "key 'format'", "twice"},
        {{"sw/plan.json", "{\"format\": \"mmh-sweep-plan-1\", \"format\": \"x\"}"}}},
       {"sensor-check: data missing", "sensor-check --data {D}/none --out {OUT}", {"none"}},
+      {"sensor-check: view object absent", "sensor-check --view-object 99 --out {OUT}",
+       {"000001-label.png: object", "got 99", "a label the image holds"}},
+      {"sensor-check: view without a sequence", "sensor-check --sequence '' --out {OUT}",
+       {"--view", "a --sequence whose first frame it shows"}},
   };
 
   // Study CSV damage: a copy of the example with one file changed.

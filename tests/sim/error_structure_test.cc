@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -170,6 +171,47 @@ TEST(ErrorStructure, TemporalCorrelationIsTheFixedShareOfTheResidualVariance) {
   EXPECT_EQ(AnalyseTemporalCorrelation(a, b, kWidth, kHeight, {}).patches, windows - 1);
   EXPECT_THROW(AnalyseTemporalCorrelation(a, std::vector<float>(10), kWidth, kHeight, {}),
                InputError);
+}
+
+TEST(ErrorStructure, NeighbourhoodCountsTheObjectsGrownMaskAndTheRunsTouchingIt) {
+  // A wall at 2 m; rows [50, 70) hold a near box (1 m) over columns [100, 120) with a 4-px shadow
+  // run left of it and a 2-px edge run right of it (in rows 50-59 a 6-px one); a 5-px shadow run
+  // of another object far away (columns [250, 255) beside a near board [255, 265)) must not count.
+  std::vector<float> depth(kWidth * kHeight, 2.0f);
+  std::vector<uint8_t> mask(depth.size(), 0);
+  for (int v = 50; v < 70; ++v) {
+    float* row = &depth[v * kWidth];
+    for (int u = 100; u < 120; ++u) {
+      row[u] = 1.0f;
+      mask[v * kWidth + u] = 1;
+    }
+    for (int u = 96; u < 100; ++u) row[u] = 0;
+    const int edge = v < 60 ? 6 : 2;
+    for (int u = 120; u < 120 + edge; ++u) row[u] = 0;
+    for (int u = 255; u < 265; ++u) row[u] = 1.0f;
+    for (int u = 250; u < 255; ++u) row[u] = 0;
+  }
+  // Radius 3: the mask grown to columns [97, 123) and rows [47, 73): 26 x 26 pixels, of which
+  // the shadow runs' last 3 columns and the edge runs' first 3 (rows 50-59) or 2 are missing.
+  const NeighbourhoodStructure n = AnalyseNeighbourhood(depth, kWidth, kHeight, mask, 3);
+  EXPECT_DOUBLE_EQ(n.pixels, 26.0 * 26.0);
+  EXPECT_DOUBLE_EQ(n.missing_share, (20.0 * 3 + 10.0 * 3 + 10.0 * 2) / (26.0 * 26.0));
+  EXPECT_EQ(n.shadow_runs, 20);  // the far board's runs lie outside
+  EXPECT_EQ(n.edge_runs, 20);
+  EXPECT_DOUBLE_EQ(n.shadow_band_px, 4.0);  // whole runs, not their part inside
+  EXPECT_DOUBLE_EQ(n.edge_band_px, 4.0);    // median of ten 6s and ten 2s
+  // Radius 0: the mask itself, nothing missing in it, but the runs beside it do not touch it.
+  const NeighbourhoodStructure inside = AnalyseNeighbourhood(depth, kWidth, kHeight, mask, 0);
+  EXPECT_DOUBLE_EQ(inside.pixels, 400.0);
+  EXPECT_DOUBLE_EQ(inside.missing_share, 0.0);
+  EXPECT_EQ(inside.shadow_runs + inside.edge_runs, 0);
+  EXPECT_TRUE(std::isnan(inside.edge_band_px));
+  // A radius reaching the image's sides is clipped to it.
+  EXPECT_DOUBLE_EQ(AnalyseNeighbourhood(depth, kWidth, kHeight, mask, 1000).pixels,
+                   static_cast<double>(kWidth) * kHeight);
+  EXPECT_THROW(AnalyseNeighbourhood(depth, kWidth, kHeight, std::vector<uint8_t>(10), 3),
+               InputError);
+  EXPECT_THROW(AnalyseNeighbourhood(depth, kWidth, kHeight, mask, -1), InputError);
 }
 
 TEST(ErrorStructure, BadInputNamesTheField) {
