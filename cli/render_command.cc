@@ -90,7 +90,7 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
       trajectory = std::filesystem::path(args.view).replace_extension(".tum").string();
     }
     view = pipeline::ReadRealView(args.sequence, args.view_label, args.view_object, args.view,
-                                  args.view_model, trajectory);
+                                  args.view_model, trajectory, render.sensor);
   }
   const sim::SensorCheckReport report =
       sim::RunSensorCheck(args.data, render, args.frames, sequence ? &*sequence : nullptr,

@@ -46,7 +46,8 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
 sim::RealView ReadRealView(const std::filesystem::path& folder, const std::filesystem::path& label,
                            int object, const std::filesystem::path& view,
                            const std::filesystem::path& model,
-                           const std::filesystem::path& trajectory) {
+                           const std::filesystem::path& trajectory,
+                           const sim::KinectSensorOptions& sensor) {
   sim::DepthSequence first = ReadDepthSequence(folder, 1);
   sim::RealView real;
   real.name = first.name + " frame 1";
@@ -72,9 +73,14 @@ sim::RealView ReadRealView(const std::filesystem::path& folder, const std::files
                   "a label the image holds");
   }
   Config config = Config::Load(view);
+  if (config.root().contains("sensor")) {
+    ThrowBadValue(view.string() + ": sensor", "a sensor section",
+                  "none (the view is rendered by the sensor under test: --config and --set)");
+  }
   config.Set("render.proxy=" + nlohmann::json(model.string()).dump());
   config.Set("render.trajectory=" + nlohmann::json(trajectory.string()).dump());
   real.config = sim::RenderConfig::FromConfig(config);
+  real.config.sensor = sensor;
   return real;
 }
 

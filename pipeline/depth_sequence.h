@@ -17,11 +17,14 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
 // A real frame and the same view rendered (sim::RealView): the first frame of the recording in
 // `folder`, the object's pixels where `label` (an 8-bit label image of that frame, YCB-Video's
 // -label.png) holds `object`, and the view's render config from `view` (render_real_view.py's
-// output without paths) with `model` as the proxy and `trajectory` as its poses. InputError
-// naming the file when the label image differs in size or holds no pixel of the object.
+// output without paths) with `model` as the proxy and `trajectory` as its poses, rendered by
+// `sensor` (the sensor under test: the view file places things, it does not choose the sensor).
+// InputError naming the file when the label image differs in size or holds no pixel of the
+// object, or when the view file has a sensor section.
 sim::RealView ReadRealView(const std::filesystem::path& folder, const std::filesystem::path& label,
                            int object, const std::filesystem::path& view,
                            const std::filesystem::path& model,
-                           const std::filesystem::path& trajectory);
+                           const std::filesystem::path& trajectory,
+                           const sim::KinectSensorOptions& sensor);
 
 }  // namespace mmh::pipeline

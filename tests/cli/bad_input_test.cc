@@ -751,6 +751,9 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
       {"sensor-check: data missing", "sensor-check --data {D}/none --out {OUT}", {"none"}},
       {"sensor-check: view object absent", "sensor-check --view-object 99 --out {OUT}",
        {"000001-label.png: object", "got 99", "a label the image holds"}},
+      {"sensor-check: view choosing its sensor", "sensor-check --view {D}/v.json --out {OUT}",
+       {"v.json: sensor", "the sensor under test"},
+       {{"v.json", "{\"sensor\": {\"mode\": \"statistical\"}}"}}},
       {"sensor-check: view without a sequence", "sensor-check --sequence '' --out {OUT}",
        {"--view", "a --sequence whose first frame it shows"}},
   };
