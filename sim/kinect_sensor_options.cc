@@ -60,6 +60,12 @@ void KinectSensorOptions::Validate(const std::string& prefix) const {
   missing.Validate(prefix + ".missing");
   color.Validate(prefix + ".color");
   structured_light.Validate(prefix + ".structured_light");
+  if (structured_light.lattice_search && calibration.subpixel_steps != 8) {
+    ThrowBadValue(prefix + ".structured_light.lattice_search", "true",
+                  "false with calibration.subpixel_steps " +
+                      std::to_string(calibration.subpixel_steps) +
+                      " (the search shifts the pattern by its 1/8 px samples)");
+  }
   if (!std::isfinite(frame_rate) || frame_rate <= 0 || frame_rate > 1000) {
     ThrowBadValue(prefix + ".frame_rate", FormatNumber(frame_rate), "a rate in (0, 1000] Hz");
   }

@@ -75,6 +75,12 @@ struct StructuredLightOptions {
   // integer match, its rejections and the matches to other surfaces stay).
   bool edge_candidates = true;
   bool parabola_subpixel = true;
+  // Sub-pixel disparity by correlating against the reference shifted by the raw lattice values
+  // (1/8 px) near the Gaussian fit (a climb to the best, within a pixel of the integer match)
+  // instead of taking the fit itself (docs/sensor.md, "Sub-pixel search on the lattice"). Its
+  // per-pixel search costs about 12 times the IR image and matching step; requires
+  // subpixel_steps 8 (the pattern's sampling).
+  bool lattice_search = false;
 
   template <class V>
   void VisitFields(V& v) {
@@ -95,6 +101,7 @@ struct StructuredLightOptions {
     v("ambiguity_ratio", ambiguity_ratio);
     v("edge_candidates", edge_candidates);
     v("parabola_subpixel", parabola_subpixel);
+    v("lattice_search", lattice_search);
   }
   void Validate(const std::string& prefix) const;
 };

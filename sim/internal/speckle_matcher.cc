@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
+#include "core/error.h"
 #include "core/simd.h"
 #include "sim/internal/avx2_kernels.h"
 #include "sim/internal/avx512_kernels.h"
@@ -439,6 +441,7 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
   float peak = 0.0f;
   for (const float x : pattern_) peak = std::max(peak, x);
   const double scale = peak > 0.0f ? levels_ / static_cast<double>(peak) : 0.0;
+  reference_scale_ = scale;
   reference_.resize(static_cast<size_t>(height) * columns_);
   for (int v = 0; v < height; ++v) {
     for (int c = 0; c < columns_; ++c) {
@@ -547,6 +550,28 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
         z >= output.min_depth && z <= output.max_depth
             ? static_cast<int32_t>(std::min(65535.0f, std::floor(z * output.inverse_scale + 0.5f)))
             : 0;
+  }
+  if (options_.lattice_search && output.raw_offset != lattice_offset_) {
+    if (output.subpixel_steps != kSubsamples) {
+      ThrowBadValue("sensor.structured_light.lattice_search", "true",
+                    "false with subpixel_steps " + std::to_string(output.subpixel_steps) +
+                        " (the pattern is sampled every 1/" + std::to_string(kSubsamples) +
+                        " px)");
+    }
+    // Raw value r shifts the reference by raw_offset - r samples: position (u - x_min) 8 -
+    // raw_offset + r = k + phase with k = (u - x_min) 8 + r + floor(-raw_offset).
+    lattice_floor_ = static_cast<int>(std::floor(-output.raw_offset));
+    const double phase = -static_cast<double>(output.raw_offset) - lattice_floor_;
+    lattice_reference_.assign(static_cast<size_t>(height_) * samples_, 0);
+    for (int v = 0; v < height_; ++v) {
+      const float* row = &pattern_[static_cast<size_t>(v) * samples_];
+      int32_t* out = &lattice_reference_[static_cast<size_t>(v) * samples_];
+      for (int k = 0; k + 1 < samples_; ++k) {
+        out[k] = static_cast<int32_t>(
+            std::lround(reference_scale_ * (row[k] + phase * (row[k + 1] - row[k]))));
+      }
+    }
+    lattice_offset_ = output.raw_offset;
   }
   // The IR image as padded 32-bit rows.
   const int stride = width_ + kBlock;
@@ -720,10 +745,68 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
           }
         }
       }
+      if (options_.lattice_search) {
+        SearchLattice(output, v, start, span, s.code.data(), s.best_d.data(),
+                      s.disparity.data());
+      }
       Output(output, s.code.data(), s.disparity.data(), span,
              depth + static_cast<size_t>(v) * w + start,
              cause != nullptr ? cause + static_cast<size_t>(v) * w + start : nullptr);
     }
+  }
+}
+
+double SpeckleMatcher::LatticeScore(int u, int v, int raw) const {
+  const int rad = radius_;
+  const int stride = width_ + kBlock;
+  int64_t si = 0, sii = 0, sr = 0, srr = 0, sir = 0;
+  for (int j = -rad; j <= rad; ++j) {
+    const int32_t* image = &wide_ir_[static_cast<size_t>(v + j) * stride];
+    const int32_t* reference = &lattice_reference_[static_cast<size_t>(v + j) * samples_];
+    const int base = (u - x_min_) * kSubsamples + raw + lattice_floor_;
+    for (int i = -rad; i <= rad; ++i) {
+      const int64_t a = image[u + i];
+      const int64_t b = reference[base + i * kSubsamples];
+      si += a;
+      sii += a * a;
+      sr += b;
+      srr += b * b;
+      sir += a * b;
+    }
+  }
+  const int64_t n = static_cast<int64_t>(options_.window_px) * options_.window_px;
+  const double a2 = static_cast<double>(n * sii - si * si);
+  const double b2 = static_cast<double>(n * srr - sr * sr);
+  if (!(a2 > 0) || !(b2 > 0)) return -std::numeric_limits<double>::infinity();
+  return static_cast<double>(n * sir - si * sr) / std::sqrt(a2 * b2);
+}
+
+void SpeckleMatcher::SearchLattice(const SpeckleOutput& output, int v, int start, int n,
+                                   const int* code, const int* best_d, float* disparity) const {
+  const float steps = output.subpixel_steps;
+  for (int k = 0; k < n; ++k) {
+    if (code[k] != 0) continue;
+    const int u = start + k;
+    // Raw values within a pixel of the integer match (and inside the pattern's columns).
+    const int lowest = static_cast<int>(
+        std::ceil(output.raw_offset - steps * static_cast<float>(std::min(best_d[k] + 1, max_d_))));
+    const int highest = static_cast<int>(
+        std::floor(output.raw_offset - steps * static_cast<float>(std::max(best_d[k] - 1, 0))));
+    int raw = static_cast<int>(std::floor(output.raw_offset - steps * disparity[k] + 0.5f));
+    raw = std::clamp(raw, lowest, highest);
+    double best = LatticeScore(u, v, raw);
+    for (const int step : {1, -1}) {
+      bool moved = false;
+      while (raw + step >= lowest && raw + step <= highest) {
+        const double score = LatticeScore(u, v, raw + step);
+        if (!(score > best)) break;
+        best = score;
+        raw += step;
+        moved = true;
+      }
+      if (moved) break;
+    }
+    disparity[k] = (output.raw_offset - static_cast<float>(raw)) / steps;
   }
 }
 

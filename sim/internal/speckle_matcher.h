@@ -64,6 +64,12 @@ class SpeckleMatcher {
   // Rows [v0, v1) (their windows inside the image).
   void MatchBand(const SpeckleScene& scene, const SpeckleOutput& output, int v0, int v1,
                  BandScratch& s, uint16_t* depth, MissingCause* cause) const;
+  // StructuredLightOptions::lattice_search: the matched pixels of row v, columns [start, start +
+  // n), moved to the raw lattice value whose reference shift correlates best (a climb from the
+  // Gaussian fit's, within a pixel of the integer match).
+  void SearchLattice(const SpeckleOutput& output, int v, int start, int n, const int* code,
+                     const int* best_d, float* disparity) const;
+  double LatticeScore(int u, int v, int raw) const;
   // Depth and cause of n pixels from their verdicts and disparities.
   void Output(const SpeckleOutput& output, const int* code, const float* disparity, int n,
               uint16_t* depth, MissingCause* cause) const;
@@ -88,6 +94,13 @@ class SpeckleMatcher {
   std::vector<int> centre_, centre_low_, blocked_;
   std::vector<int32_t> units_by_raw_;  // per frame: depth units of raw values 0 .. 2047 (0: none)
   std::vector<int32_t> wide_ir_;        // per frame: the IR image, rows padded to width + 16
+  // lattice_search: the pattern at sample positions k + lattice_phase_ (ADC counts, as
+  // reference_), so that every raw lattice value's shift is a whole sample; for raw_offset
+  // lattice_offset_.
+  std::vector<int32_t> lattice_reference_;
+  float lattice_offset_ = -1;
+  int lattice_floor_ = 0;  // floor(-raw_offset)
+  double reference_scale_ = 0;
   // Scratch per worker thread (by its index in the task arena), kept from frame to frame.
   std::vector<std::unique_ptr<BandScratch>> scratch_;
 };

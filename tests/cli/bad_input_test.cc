@@ -573,6 +573,10 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
       {"render: png compression",
        "render --set render.png_compression=12 --out {OUT}",
        {"render.png_compression", "12"}},
+      {"render: lattice search on another lattice",
+       "render --set sensor.structured_light.lattice_search=true "
+       "--set sensor.calibration.subpixel_steps=4 --out {OUT}",
+       {"sensor.structured_light.lattice_search: got true", "calibration.subpixel_steps 4"}},
       {"render: NaN frame rate",
        "render --set sensor.frame_rate=NaN --out {OUT}",
        {"sensor.frame_rate", "NaN"}},

@@ -197,18 +197,125 @@ TEST(SpeckleMatcher, MatchesTheBruteForceCorrelationOfEveryWindow) {
 }
 
 TEST(SpeckleMatcher, GivesTheSameBytesForAnyThreadCount) {
-  StructuredLightOptions options;
-  const TestScene scene = MakeScene();
-  const size_t n = static_cast<size_t>(kWidth) * kHeight;
-  std::vector<uint16_t> ir(n), depth1(n), depth2(n);
-  SpeckleMatcher matcher(options, kWidth, kHeight, kFocalBaseline / 0.4);
-  matcher.RenderIr(scene.view(), 7u, ir.data());
-  {
-    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    matcher.Match(scene.view(), ir.data(), Output(), depth1.data());
+  for (const bool lattice : {false, true}) {
+    StructuredLightOptions options;
+    options.lattice_search = lattice;
+    const TestScene scene = MakeScene();
+    const size_t n = static_cast<size_t>(kWidth) * kHeight;
+    std::vector<uint16_t> ir(n), depth1(n), depth2(n);
+    SpeckleMatcher matcher(options, kWidth, kHeight, kFocalBaseline / 0.4);
+    matcher.RenderIr(scene.view(), 7u, ir.data());
+    {
+      tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+      matcher.Match(scene.view(), ir.data(), Output(), depth1.data());
+    }
+    matcher.Match(scene.view(), ir.data(), Output(), depth2.data());
+    EXPECT_EQ(depth1, depth2) << "lattice_search " << lattice;
   }
-  matcher.Match(scene.view(), ir.data(), Output(), depth2.data());
-  EXPECT_EQ(depth1, depth2);
+}
+
+// lattice_search: every matched pixel's raw value is a local maximum, over the raw lattice, of
+// the correlation of its window with the reference shifted by that raw value's disparity (the
+// oracle builds that reference from the projected pattern itself, Pattern(), in double
+// precision), and lies within a pixel of the integer match. Both lattice phases: raw_offset whole
+// and half.
+TEST(SpeckleMatcher, LatticeSearchEndsOnALocalMaximumOfTheCorrelation) {
+  StructuredLightOptions options;
+  options.lattice_search = true;
+  const TestScene scene = MakeScene();
+  const double max_disparity = kFocalBaseline / 0.4;
+  SpeckleMatcher matcher(options, kWidth, kHeight, max_disparity);
+  const size_t n = static_cast<size_t>(kWidth) * kHeight;
+  std::vector<uint16_t> ir(n), depth(n);
+  matcher.RenderIr(scene.view(), 12345u, ir.data());
+  for (const float raw_offset : {1090.0f, 1092.5f}) {
+    SpeckleOutput out = Output();
+    out.raw_offset = raw_offset;
+    matcher.Match(scene.view(), ir.data(), out, depth.data());
+    const int rad = options.window_px / 2;
+    auto score = [&](int u, int v, double raw) {
+      const double d = (raw_offset - raw) / 8;
+      double sa = 0, saa = 0, sb = 0, sbb = 0, sab = 0;
+      for (int j = -rad; j <= rad; ++j) {
+        for (int i = -rad; i <= rad; ++i) {
+          const double a = ir[(v + j) * kWidth + u + i];
+          const double b = matcher.Pattern(static_cast<float>(u + i - d), v + j);
+          sa += a;
+          saa += a * a;
+          sb += b;
+          sbb += b * b;
+          sab += a * b;
+        }
+      }
+      const double m = options.window_px * options.window_px;
+      return (m * sab - sa * sb) / std::sqrt((m * saa - sa * sa) * (m * sbb - sb * sb));
+    };
+    int matched = 0, not_maximum = 0;
+    for (int v = rad; v < kHeight - rad; ++v) {
+      for (int u = rad; u < kWidth - rad; ++u) {
+        const size_t p = static_cast<size_t>(v) * kWidth + u;
+        if (depth[p] == 0) continue;
+        ++matched;
+        const double z = depth[p] / 5000.0;
+        const double raw = std::round(raw_offset - out.lattice / z);
+        const double here = score(u, v, raw);
+        if (here < score(u, v, raw - 1) - 1e-9 || here < score(u, v, raw + 1) - 1e-9) {
+          ++not_maximum;
+        }
+        // Away from the step and the empty column (where windows match the other surface: edge
+        // fattening), within a pixel and a rounding of the rendered disparity.
+        if (std::abs(u - 90) > rad + 2 && std::abs(u - 150) > rad + 2) {
+          EXPECT_LE(std::abs((raw_offset - raw) / 8 - scene.disparity[p]), 1.6) << u << " " << v;
+        }
+      }
+    }
+    EXPECT_GT(matched, static_cast<int>(n / 2));
+    // The matcher's reference is rounded to ADC counts, the oracle's is not: a near tie may flip
+    // (measured: 59 of 10 651 pixels at raw_offset 1090).
+    EXPECT_LE(not_maximum, matched / 100) << not_maximum << " of " << matched << " at "
+                                           << raw_offset;
+  }
+}
+
+// What the search is for: on a slanted wall its disparities are nearer the truth than the
+// Gaussian fit's (docs/sensor.md, "Sub-pixel search on the lattice"). Measured: 0.077 px against
+// 0.084 px root mean square: the fit's share of the sub-pixel error is small.
+TEST(SpeckleMatcher, LatticeSearchErrsLessThanTheGaussianFit) {
+  TestScene scene = MakeScene();
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      const size_t p = static_cast<size_t>(v) * kWidth + u;
+      scene.depth[p] = static_cast<float>(1.0 + 0.002 * u + 0.001 * v);
+      scene.disparity[p] = static_cast<float>(kFocalBaseline / scene.depth[p]);
+      scene.occluded[p] = 0;
+      scene.diffuse[p] = 0.6f;
+      scene.specular[p] = 0.0f;
+      scene.cos_incidence[p] = 0.9f;
+    }
+  }
+  auto rms = [&](bool lattice) {
+    StructuredLightOptions options;
+    options.lattice_search = lattice;
+    SpeckleMatcher matcher(options, kWidth, kHeight, kFocalBaseline / 0.4);
+    const size_t n = static_cast<size_t>(kWidth) * kHeight;
+    std::vector<uint16_t> ir(n), depth(n);
+    matcher.RenderIr(scene.view(), 99u, ir.data());
+    const SpeckleOutput out = Output();
+    matcher.Match(scene.view(), ir.data(), out, depth.data());
+    double sum = 0;
+    int count = 0;
+    for (size_t p = 0; p < n; ++p) {
+      if (depth[p] == 0) continue;
+      const double raw = std::round(out.raw_offset - out.lattice / (depth[p] / 5000.0));
+      const double error = (out.raw_offset - raw) / 8 - scene.disparity[p];
+      sum += error * error;
+      ++count;
+    }
+    EXPECT_GT(count, static_cast<int>(n / 2));
+    return std::sqrt(sum / count);
+  };
+  const double gaussian = rms(false), lattice = rms(true);
+  EXPECT_LT(lattice, 0.95 * gaussian) << "lattice " << lattice << " px, Gaussian fit " << gaussian;
 }
 
 }  // namespace
