@@ -93,9 +93,9 @@ void RunRun(const RunArgs& args, const std::vector<std::string>& argv) {
       seconds.total, seconds.record, seconds.annotate, seconds.compose,
       pipeline::RenderTrackFramesPerSecond(run));
   std::printf(
-      "written: %s/{metrics.json, metrics.csv, tracking_frames.csv, seams.csv, takes/, "
+      "written: %s/{metrics.json, metrics.csv, tracking_frames.csv, %sseams.csv, takes/, "
       "montage/, montage_truth/, timings.csv, config.resolved.json, run.json}\n",
-      out.string().c_str());
+      out.string().c_str(), run_config.run.fidelity == pipeline::Fidelity::kFull ? "tracking_errors.csv, " : "");
 }
 
 }  // namespace

@@ -77,7 +77,7 @@ AnimatorRun RunToFolder(const RunConfig& config, const std::filesystem::path& ou
     write_provenance({{"failed", true}});
     throw;
   }
-  WriteAnimatorRun(out, run);
+  WriteAnimatorRun(out, run, config.run.fidelity == Fidelity::kFull);
   if (options.write_more) options.write_more(run);
   WriteFileAtomically(out / "timings.csv", TimingsToCsv(run));
   write_provenance(SecondsToJson(run));

@@ -1,6 +1,7 @@
 #include "pipeline/run_output.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <sstream>
 
 #include "core/annotation.h"
@@ -11,6 +12,7 @@
 #include "core/tum_io.h"
 #include "metrics/tracking_metrics.h"
 #include "pipeline/run_metrics.h"
+#include "pipeline/tracking_frames.h"
 
 namespace mmh::pipeline {
 
@@ -208,7 +210,8 @@ std::string MetricsToCsv(const nlohmann::json& metrics) {
   return csv.str();
 }
 
-void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run) {
+void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run,
+                      bool full_fidelity) {
   EnsureDirectory(out);
   WriteMontage(out / "montage", run.montage, "the tracked takes and read annotations");
   WriteMontage(out / "montage_truth", run.truth_montage, "the ground truth");
@@ -250,6 +253,16 @@ void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run) 
     }
   }
   WriteFileAtomically(out / "tracking_frames.csv", frames.str());
+
+  // Full fidelity: every tracked frame against its truth, in the study's format, for refitting
+  // the fast mode's error model from a run (`mmh error-model --frames`). Fast fidelity draws its
+  // errors from that model and has no camera: nothing to measure.
+  if (full_fidelity) {
+    char animator[16];
+    std::snprintf(animator, sizeof(animator), "A%02d", run.participant.index + 1);
+    WriteFileAtomically(out / "tracking_errors.csv",
+                        TakeFramesCsv(MeasureRunFrames(animator, run.takes)));
+  }
 }
 
 }  // namespace mmh::pipeline

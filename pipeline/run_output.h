@@ -30,8 +30,10 @@ void WriteTakeRun(const std::filesystem::path& out, const TakeRun& take, bool pr
 bool LoadTakeRun(const std::filesystem::path& out, TakeRun& take, bool practice);
 
 // Montages, metrics and tidy tables (the takes are written by WriteTakeRun); run.metrics must be
-// set (run.metrics true).
-void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run);
+// set (run.metrics true). `full_fidelity`: the takes were rendered and tracked (now or in the
+// run resumed), so every frame is measured against its truth into tracking_errors.csv.
+void WriteAnimatorRun(const std::filesystem::path& out, const AnimatorRun& run,
+                      bool full_fidelity);
 
 // The tidy metrics table of a metrics.json.
 std::string MetricsToCsv(const nlohmann::json& metrics);

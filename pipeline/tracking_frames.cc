@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/text_parsing.h"
+#include "pipeline/animator_run.h"
 
 namespace mmh::pipeline {
 namespace {
@@ -231,6 +232,21 @@ std::vector<TakeFrames> ReadTakeFramesCsv(const std::filesystem::path& path) {
   }
   if (!header_seen) throw InputError(path.string() + ": empty, expected the header '" + kHeader + "'");
   return takes;
+}
+
+std::vector<TakeFrames> MeasureRunFrames(const std::string& animator,
+                                         const std::vector<TakeRun>& takes) {
+  std::vector<TakeFrames> frames;
+  frames.reserve(takes.size());
+  for (const TakeRun& take : takes) {
+    const TrackingObservation tracking{&take.truth, &take.tracked, &take.status,
+                                       take.camera_T_table.Inverse().translation};
+    const ReadingObservation reading{&take.truth_annotation, &take.read_annotation,
+                                     &take.slider_found};
+    frames.push_back(MeasureTakeFrames(animator, take.take, tracking,
+                                       take.truth_annotation.values.empty() ? nullptr : &reading));
+  }
+  return frames;
 }
 
 }  // namespace mmh::pipeline

@@ -77,6 +77,15 @@ TakeFrames MeasureTakeFrames(const std::string& animator, int take,
                              const TrackingObservation& tracking,
                              const ReadingObservation* reading);
 
+struct TakeRun;  // pipeline/animator_run.h
+
+// The frames of every take of one animator's run at full fidelity (the takes' true camera pose
+// places the camera; in fast fidelity it is the identity and the table would be meaningless).
+// Takes without a slider reading (truth_annotation empty) have no slider columns. Used by the
+// study (tracking_errors.csv of all animators) and `mmh run` (its own tracking_errors.csv).
+std::vector<TakeFrames> MeasureRunFrames(const std::string& animator,
+                                         const std::vector<TakeRun>& takes);
+
 // The table as CSV, one row per frame, columns
 //   animator,take,frame,time_s,status,heading_deg,tilt_deg,speed_m_s,turn_rate_rad_s,
 //   error_rx_rad,error_ry_rad,error_rz_rad,error_tx_m,error_ty_m,error_tz_m,

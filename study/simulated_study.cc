@@ -183,13 +183,8 @@ SimulatedStudy RunSimulatedStudy(const StudyConfig& config, int replicate,
 
   if (config.run.run.fidelity == pipeline::Fidelity::kFull) {
     for (const auto& a : study.animators) {
-      for (const auto& take : a.takes) {
-        const pipeline::TrackingObservation tracking{
-            &take.truth, &take.tracked, &take.status, take.camera_T_table.Inverse().translation};
-        const pipeline::ReadingObservation reading{&take.truth_annotation, &take.read_annotation,
-                                                   &take.slider_found};
-        study.tracking_frames.push_back(pipeline::MeasureTakeFrames(
-            a.id, take.take, tracking, take.truth_annotation.values.empty() ? nullptr : &reading));
+      for (pipeline::TakeFrames& take : pipeline::MeasureRunFrames(a.id, a.takes)) {
+        study.tracking_frames.push_back(std::move(take));
       }
     }
     study.measured_error_model =

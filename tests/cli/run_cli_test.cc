@@ -1,6 +1,7 @@
 // `mmh run` and `mmh regress` through the binary.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -32,7 +33,8 @@ TEST(RunCliTest, WritesEveryResultAndTheSameBytesForAnyThreadCount) {
   const auto two = RunMmh(ShortRun(dir / "two", "--threads 2"));
   ASSERT_EQ(two.exit_code, 0) << two.output;
   for (const char* file :
-       {"metrics.json", "metrics.csv", "tracking_frames.csv", "seams.csv", "config.resolved.json",
+       {"metrics.json", "metrics.csv", "tracking_frames.csv", "tracking_errors.csv", "seams.csv",
+        "config.resolved.json",
         "takes/take_0/truth.tum", "takes/take_0/tracked.tum", "takes/take_0/status.csv",
         "takes/take_0/truth_annotation.csv", "takes/take_1/read_annotation.csv",
         "takes/take_1/quality.csv", "montage/montage.tum", "montage/segments.csv",
@@ -45,6 +47,15 @@ TEST(RunCliTest, WritesEveryResultAndTheSameBytesForAnyThreadCount) {
   EXPECT_GT(run["seconds"]["render_track_frames_per_second"].get<double>(), 0.0);
   EXPECT_NE(ReadBytes(dir / "one/metrics.csv").find("takes,0,tracking.rotation_deg.median,"),
             std::string::npos);
+  // Every tracked frame against its truth (the study's format): one row per frame of the two
+  // takes, and the error model fits from it.
+  const std::string errors = ReadBytes(dir / "one/tracking_errors.csv");
+  EXPECT_EQ(std::count(errors.begin(), errors.end(), '\n'), 1 + 2 * 70);
+  EXPECT_EQ(errors.find("\nA01,0,0,"), errors.find('\n'));
+  const auto fit = RunMmh("error-model --frames " + (dir / "one/tracking_errors.csv").string() +
+                          " --quiet --out " + (dir / "fit").string());
+  EXPECT_EQ(fit.exit_code, 0) << fit.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "fit/error_model.json"));
 }
 
 TEST(RunCliTest, BadInputExitsTwoAndWritesNothing) {
@@ -85,6 +96,7 @@ TEST(RunCliTest, ResumeReusesFinishedTakesAndRefusesInconsistentOnes) {
   const auto out = dir / "out";
   ASSERT_EQ(RunMmh(ShortRun(out)).exit_code, 0);
   const std::string tracked = ReadBytes(out / "takes/take_1/tracked.tum");
+  const std::string errors = ReadBytes(out / "tracking_errors.csv");
   // What a run killed between a write and its rename leaves (PID 2^22 + 1: above PID_MAX_LIMIT,
   // Linux's largest PID, so no process runs under it): the resumed run removes it.
   const auto stale = out / "takes/take_1/status.csv.tmp.4194305.7";
@@ -92,6 +104,7 @@ TEST(RunCliTest, ResumeReusesFinishedTakesAndRefusesInconsistentOnes) {
   auto r = RunMmh(ShortRun(out, "--resume --set montage.blend.window=5"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(ReadBytes(out / "takes/take_1/tracked.tum"), tracked);
+  EXPECT_EQ(ReadBytes(out / "tracking_errors.csv"), errors);  // from the takes read back
   EXPECT_FALSE(std::filesystem::exists(stale));
   const nlohmann::json run = nlohmann::json::parse(ReadBytes(out / "run.json"));
   EXPECT_EQ(run["seconds"]["rendered_frames"], 0);  // nothing rendered again
