@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "core/annotation.h"
@@ -156,16 +157,11 @@ bool LoadTakeRun(const std::filesystem::path& out, TakeRun& take, bool practice)
       inconsistent(where, "\"" + line + "\"",
                    annotated ? "frame,timestamp,status,slider_found" : "frame,timestamp,status");
     }
-    const std::string name(fields[2]);
-    if (name == "tracked") {
-      take.status.push_back(track::TrackStatus::kTracked);
-    } else if (name == "predicted") {
-      take.status.push_back(track::TrackStatus::kPredicted);
-    } else if (name == "lost") {
-      take.status.push_back(track::TrackStatus::kLost);
-    } else {
-      inconsistent(where, "\"" + name + "\"", "tracked, predicted or lost");
+    const std::optional<track::TrackStatus> status = track::TrackStatusFromName(fields[2]);
+    if (!status) {
+      inconsistent(where, "\"" + std::string(fields[2]) + "\"", "tracked, predicted or lost");
     }
+    take.status.push_back(*status);
     if (annotated) take.slider_found.push_back(fields[3] == "1");
     ++row;
   }

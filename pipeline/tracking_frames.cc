@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <optional>
 #include <string_view>
 
 #include "core/error.h"
@@ -195,16 +196,9 @@ std::vector<TakeFrames> ReadTakeFramesCsv(const std::filesystem::path& path) {
     }
     TrackingFrame f;
     f.time = number(3);
-    const std::string_view status = fields[4];
-    if (status == track::TrackStatusName(track::TrackStatus::kTracked)) {
-      f.status = track::TrackStatus::kTracked;
-    } else if (status == track::TrackStatusName(track::TrackStatus::kPredicted)) {
-      f.status = track::TrackStatus::kPredicted;
-    } else if (status == track::TrackStatusName(track::TrackStatus::kLost)) {
-      f.status = track::TrackStatus::kLost;
-    } else {
-      bad(4, "tracked, predicted or lost");
-    }
+    const std::optional<track::TrackStatus> status = track::TrackStatusFromName(fields[4]);
+    if (!status) bad(4, "tracked, predicted or lost");
+    f.status = *status;
     f.heading_deg = number(5);
     f.tilt_deg = number(6);
     f.speed = number(7);

@@ -14,7 +14,8 @@
 
 #include "core/annotation.h"
 #include "core/trajectory.h"
-#include "track/proxy_tracker.h"
+#include "core/rigid3.h"
+#include "track/track_status.h"
 
 namespace mmh::pipeline {
 

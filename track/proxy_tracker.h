@@ -27,12 +27,9 @@
 #include "track/segmentation.h"
 #include "track/setup.h"
 #include "track/table_plane.h"
+#include "track/track_status.h"
 
 namespace mmh::track {
-
-enum class TrackStatus { kTracked, kPredicted, kLost };
-// "tracked", "predicted", "lost".
-const char* TrackStatusName(TrackStatus status);
 
 struct DetectionOptions {
   // Orientation hypotheses: yaw_steps yaws about the table normal for each of the model's six

@@ -8,18 +8,6 @@
 
 namespace mmh::track {
 
-const char* TrackStatusName(TrackStatus status) {
-  switch (status) {
-    case TrackStatus::kTracked:
-      return "tracked";
-    case TrackStatus::kPredicted:
-      return "predicted";
-    case TrackStatus::kLost:
-      return "lost";
-  }
-  return "?";
-}
-
 void DetectionOptions::Validate(const std::string& prefix) const {
   if (yaw_steps < 1 || yaw_steps > 360) {
     ThrowBadValue(prefix + ".yaw_steps", std::to_string(yaw_steps), "an integer in [1, 360]");
