@@ -86,7 +86,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     ThrowBadValue(view.name + ": render.trajectory", "\"\"",
                   "the object's poses, the first the real frame's");
   }
-  const Rigid3 table_T_object = ReadTum(config.render.trajectory).poses.at(0);
+  // ReadTum refuses a file without poses.
+  const Rigid3 table_T_object = ReadTum(config.render.trajectory).poses.front();
   TableTopScene scene(config, LoadProxyModel(config.render.proxy, config.render.proxy_scale));
   // The object's mask: where the exact depth with the object is valid and nearer than without it
   // (the object moved far below the floor).
@@ -106,6 +107,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   std::vector<uint8_t> mask(with.size(), 0);
   for (size_t p = 0; p < with.size(); ++p) {
     mask[p] = with[p] > 0 && (!(without[p] > 0) || with[p] < without[p] - 0.005f);
+  }
+  if (std::find(mask.begin(), mask.end(), uint8_t{1}) == mask.end()) {
+    ThrowBadValue(view.name + ": the object in the rendered view", "not seen",
+                  "the object in the camera's view (render.trajectory's first pose, camera)");
   }
   const double focal = intrinsics.fx;
   const int width = intrinsics.width, height = intrinsics.height;

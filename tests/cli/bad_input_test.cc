@@ -758,6 +758,10 @@ std::vector<BadInput> Corpus(const Fixture& fx) {
       {"sensor-check: view choosing its sensor", "sensor-check --view {D}/v.json --out {OUT}",
        {"v.json: sensor", "the sensor under test"},
        {{"v.json", "{\"sensor\": {\"mode\": \"statistical\"}}"}}},
+      {"sensor-check: view object out of sight",
+       "sensor-check --view-trajectory {D}/away.tum --out {OUT}",
+       {"the object in the rendered view: got not seen", "the camera's view"},
+       {{"away.tum", "0 0 0 -50 0 0 0 1\n"}}},
       {"sensor-check: view without a sequence", "sensor-check --sequence '' --out {OUT}",
        {"--view", "a --sequence whose first frame it shows"}},
   };
