@@ -78,7 +78,7 @@ struct StructuredLightOptions {
   // Sub-pixel disparity by correlating against the reference shifted by the raw lattice values
   // (1/8 px) near the Gaussian fit (a climb to the best, within a pixel of the integer match)
   // instead of taking the fit itself (docs/sensor.md, "Sub-pixel search on the lattice"). Its
-  // per-pixel search costs about 12 times the IR image and matching step; requires
+  // per-pixel search costs about 6 times the IR image and matching step; requires
   // subpixel_steps 8 (the pattern's sampling).
   bool lattice_search = false;
 

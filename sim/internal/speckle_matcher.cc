@@ -328,6 +328,26 @@ MMH_SIMD_CLONES void Decide(const double* __restrict best, const int* __restrict
   }
 }
 
+// One window of the IR image against one of the lattice reference: sums[0] = sum a b, sums[1] =
+// sum b, sums[2] = sum b^2 over `window` rows of `window` values (exact 32-bit integers).
+MMH_SIMD_CLONES void WindowProducts(const int32_t* __restrict a, size_t a_stride,
+                                    const int32_t* __restrict b, size_t b_stride, int window,
+                                    int32_t* __restrict sums) {
+  int32_t cross = 0, sum = 0, square = 0;
+  for (int j = 0; j < window; ++j) {
+    const int32_t* x = a + j * a_stride;
+    const int32_t* y = b + j * b_stride;
+    for (int i = 0; i < window; ++i) {
+      cross += x[i] * y[i];
+      sum += y[i];
+      square += y[i] * y[i];
+    }
+  }
+  sums[0] = cross;
+  sums[1] = sum;
+  sums[2] = square;
+}
+
 // Depth units of matched pixels on the raw lattice (raw = round(raw_offset - 8 d), units from
 // the table, 0 outside [0, 2046] or the depth range: kRange); other pixels keep their code.
 MMH_SIMD_CLONES void LatticeDepth(const SpeckleOutput& output, const int32_t* __restrict table,
@@ -562,13 +582,19 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
     // raw_offset + r = k + phase with k = (u - x_min) 8 + r + floor(-raw_offset).
     lattice_floor_ = static_cast<int>(std::floor(-output.raw_offset));
     const double phase = -static_cast<double>(output.raw_offset) - lattice_floor_;
-    lattice_reference_.assign(static_cast<size_t>(height_) * samples_, 0);
-    for (int v = 0; v < height_; ++v) {
-      const float* row = &pattern_[static_cast<size_t>(v) * samples_];
-      int32_t* out = &lattice_reference_[static_cast<size_t>(v) * samples_];
-      for (int k = 0; k + 1 < samples_; ++k) {
-        out[k] = static_cast<int32_t>(
-            std::lround(reference_scale_ * (row[k] + phase * (row[k + 1] - row[k]))));
+    lattice_columns_ = columns_;
+    const size_t plane = static_cast<size_t>(height_) * lattice_columns_;
+    lattice_reference_.assign(kSubsamples * plane, 0);
+    for (int q = 0; q < kSubsamples; ++q) {
+      for (int v = 0; v < height_; ++v) {
+        const float* row = &pattern_[static_cast<size_t>(v) * samples_];
+        int32_t* out = &lattice_reference_[q * plane + static_cast<size_t>(v) * lattice_columns_];
+        for (int c = 0; c < lattice_columns_; ++c) {
+          const int k = c * kSubsamples + q;
+          if (k + 1 >= samples_) continue;
+          out[c] = static_cast<int32_t>(
+              std::lround(reference_scale_ * (row[k] + phase * (row[k + 1] - row[k]))));
+        }
       }
     }
     lattice_offset_ = output.raw_offset;
@@ -746,8 +772,8 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
         }
       }
       if (options_.lattice_search) {
-        SearchLattice(output, v, start, span, s.code.data(), s.best_d.data(),
-                      s.disparity.data());
+        SearchLattice(output, v, start, span, s.code.data(), s.best_d.data(), &s.sum[at + start],
+                      &s.inverse_norm[at + start], s.disparity.data());
       }
       Output(output, s.code.data(), s.disparity.data(), span,
              depth + static_cast<size_t>(v) * w + start,
@@ -756,33 +782,31 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
   }
 }
 
-double SpeckleMatcher::LatticeScore(int u, int v, int raw) const {
+double SpeckleMatcher::LatticeScore(int u, int v, int raw, int32_t sum,
+                                   double inverse_norm) const {
   const int rad = radius_;
+  const int window = options_.window_px;
   const int stride = width_ + kBlock;
-  int64_t si = 0, sii = 0, sr = 0, srr = 0, sir = 0;
-  for (int j = -rad; j <= rad; ++j) {
-    const int32_t* image = &wide_ir_[static_cast<size_t>(v + j) * stride];
-    const int32_t* reference = &lattice_reference_[static_cast<size_t>(v + j) * samples_];
-    const int base = (u - x_min_) * kSubsamples + raw + lattice_floor_;
-    for (int i = -rad; i <= rad; ++i) {
-      const int64_t a = image[u + i];
-      const int64_t b = reference[base + i * kSubsamples];
-      si += a;
-      sii += a * a;
-      sr += b;
-      srr += b * b;
-      sir += a * b;
-    }
-  }
-  const int64_t n = static_cast<int64_t>(options_.window_px) * options_.window_px;
-  const double a2 = static_cast<double>(n * sii - si * si);
-  const double b2 = static_cast<double>(n * srr - sr * sr);
-  if (!(a2 > 0) || !(b2 > 0)) return -std::numeric_limits<double>::infinity();
-  return static_cast<double>(n * sir - si * sr) / std::sqrt(a2 * b2);
+  // Sample index of column u's reference value: (u - x_min) 8 + raw + floor(-raw_offset).
+  const int k = (u - x_min_) * kSubsamples + raw + lattice_floor_;
+  const int q = k % kSubsamples, c = k / kSubsamples;  // k >= 0: the pattern's margin
+  const size_t plane = static_cast<size_t>(height_) * lattice_columns_;
+  int32_t sums[3];  // exact: window_px^2 (2^adc_bits - 1)^2 < 2^31 (validated)
+  WindowProducts(&wide_ir_[static_cast<size_t>(v - rad) * stride + (u - rad)], stride,
+                 &lattice_reference_[q * plane + static_cast<size_t>(v - rad) * lattice_columns_ +
+                                     (c - rad)],
+                 lattice_columns_, window, sums);
+  const int64_t n = static_cast<int64_t>(window) * window;
+  const int64_t norm2 = n * sums[2] - static_cast<int64_t>(sums[1]) * sums[1];
+  if (norm2 <= 0 || !(inverse_norm > 0)) return -std::numeric_limits<double>::infinity();
+  const double numerator =
+      static_cast<double>(n * sums[0] - static_cast<int64_t>(sum) * sums[1]);
+  return numerator * inverse_norm * (1.0 / std::sqrt(static_cast<double>(norm2)));
 }
 
 void SpeckleMatcher::SearchLattice(const SpeckleOutput& output, int v, int start, int n,
-                                   const int* code, const int* best_d, float* disparity) const {
+                                   const int* code, const int* best_d, const int32_t* sum,
+                                   const double* inverse_norm, float* disparity) const {
   const float steps = output.subpixel_steps;
   for (int k = 0; k < n; ++k) {
     if (code[k] != 0) continue;
@@ -794,11 +818,11 @@ void SpeckleMatcher::SearchLattice(const SpeckleOutput& output, int v, int start
         std::floor(output.raw_offset - steps * static_cast<float>(std::max(best_d[k] - 1, 0))));
     int raw = static_cast<int>(std::floor(output.raw_offset - steps * disparity[k] + 0.5f));
     raw = std::clamp(raw, lowest, highest);
-    double best = LatticeScore(u, v, raw);
+    double best = LatticeScore(u, v, raw, sum[k], inverse_norm[k]);
     for (const int step : {1, -1}) {
       bool moved = false;
       while (raw + step >= lowest && raw + step <= highest) {
-        const double score = LatticeScore(u, v, raw + step);
+        const double score = LatticeScore(u, v, raw + step, sum[k], inverse_norm[k]);
         if (!(score > best)) break;
         best = score;
         raw += step;

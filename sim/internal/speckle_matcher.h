@@ -67,9 +67,13 @@ class SpeckleMatcher {
   // StructuredLightOptions::lattice_search: the matched pixels of row v, columns [start, start +
   // n), moved to the raw lattice value whose reference shift correlates best (a climb from the
   // Gaussian fit's, within a pixel of the integer match).
+  // `sum`, `inverse_norm`: the IR windows' statistics of pixels [start, start + n) of row v.
   void SearchLattice(const SpeckleOutput& output, int v, int start, int n, const int* code,
-                     const int* best_d, float* disparity) const;
-  double LatticeScore(int u, int v, int raw) const;
+                     const int* best_d, const int32_t* sum, const double* inverse_norm,
+                     float* disparity) const;
+  // The correlation of pixel (u, v)'s window, whose IR sum and inverse norm are given, with the
+  // reference shifted by raw value `raw`.
+  double LatticeScore(int u, int v, int raw, int32_t sum, double inverse_norm) const;
   // Depth and cause of n pixels from their verdicts and disparities.
   void Output(const SpeckleOutput& output, const int* code, const float* disparity, int n,
               uint16_t* depth, MissingCause* cause) const;
@@ -94,10 +98,12 @@ class SpeckleMatcher {
   std::vector<int> centre_, centre_low_, blocked_;
   std::vector<int32_t> units_by_raw_;  // per frame: depth units of raw values 0 .. 2047 (0: none)
   std::vector<int32_t> wide_ir_;        // per frame: the IR image, rows padded to width + 16
-  // lattice_search: the pattern at sample positions k + lattice_phase_ (ADC counts, as
-  // reference_), so that every raw lattice value's shift is a whole sample; for raw_offset
-  // lattice_offset_.
+  // lattice_search: the pattern at sample positions k + phase (ADC counts, as reference_), so that
+  // every raw lattice value's shift is a whole sample; for raw_offset lattice_offset_. Stored by
+  // phase k mod 8, then row, then column k div 8 (lattice_columns_ per row), so that a window's
+  // row is contiguous.
   std::vector<int32_t> lattice_reference_;
+  int lattice_columns_ = 0;
   float lattice_offset_ = -1;
   int lattice_floor_ = 0;  // floor(-raw_offset)
   double reference_scale_ = 0;
