@@ -582,14 +582,13 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
     // raw_offset + r = k + phase with k = (u - x_min) 8 + r + floor(-raw_offset).
     lattice_floor_ = static_cast<int>(std::floor(-output.raw_offset));
     const double phase = -static_cast<double>(output.raw_offset) - lattice_floor_;
-    lattice_columns_ = columns_;
-    const size_t plane = static_cast<size_t>(height_) * lattice_columns_;
+    const size_t plane = static_cast<size_t>(height_) * columns_;
     lattice_reference_.assign(kSubsamples * plane, 0);
     for (int q = 0; q < kSubsamples; ++q) {
       for (int v = 0; v < height_; ++v) {
         const float* row = &pattern_[static_cast<size_t>(v) * samples_];
-        int32_t* out = &lattice_reference_[q * plane + static_cast<size_t>(v) * lattice_columns_];
-        for (int c = 0; c < lattice_columns_; ++c) {
+        int32_t* out = &lattice_reference_[q * plane + static_cast<size_t>(v) * columns_];
+        for (int c = 0; c < columns_; ++c) {
           const int k = c * kSubsamples + q;
           if (k + 1 >= samples_) continue;
           out[c] = static_cast<int32_t>(
@@ -790,12 +789,12 @@ double SpeckleMatcher::LatticeScore(int u, int v, int raw, int32_t sum,
   // Sample index of column u's reference value: (u - x_min) 8 + raw + floor(-raw_offset).
   const int k = (u - x_min_) * kSubsamples + raw + lattice_floor_;
   const int q = k % kSubsamples, c = k / kSubsamples;  // k >= 0: the pattern's margin
-  const size_t plane = static_cast<size_t>(height_) * lattice_columns_;
+  const size_t plane = static_cast<size_t>(height_) * columns_;
   int32_t sums[3];  // exact: window_px^2 (2^adc_bits - 1)^2 < 2^31 (validated)
   WindowProducts(&wide_ir_[static_cast<size_t>(v - rad) * stride + (u - rad)], stride,
-                 &lattice_reference_[q * plane + static_cast<size_t>(v - rad) * lattice_columns_ +
+                 &lattice_reference_[q * plane + static_cast<size_t>(v - rad) * columns_ +
                                      (c - rad)],
-                 lattice_columns_, window, sums);
+                 columns_, window, sums);
   const int64_t n = static_cast<int64_t>(window) * window;
   const int64_t norm2 = n * sums[2] - static_cast<int64_t>(sums[1]) * sums[1];
   if (norm2 <= 0 || !(inverse_norm > 0)) return -std::numeric_limits<double>::infinity();

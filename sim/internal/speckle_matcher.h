@@ -100,10 +100,9 @@ class SpeckleMatcher {
   std::vector<int32_t> wide_ir_;        // per frame: the IR image, rows padded to width + 16
   // lattice_search: the pattern at sample positions k + phase (ADC counts, as reference_), so that
   // every raw lattice value's shift is a whole sample; for raw_offset lattice_offset_. Stored by
-  // phase k mod 8, then row, then column k div 8 (lattice_columns_ per row), so that a window's
+  // phase k mod 8, then row, then column k div 8 (columns_ per row), so that a window's
   // row is contiguous.
   std::vector<int32_t> lattice_reference_;
-  int lattice_columns_ = 0;
   float lattice_offset_ = -1;
   int lattice_floor_ = 0;  // floor(-raw_offset)
   double reference_scale_ = 0;
