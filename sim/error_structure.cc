@@ -126,6 +126,23 @@ void ErrorStructureOptions::Validate(const std::string& prefix) const {
   }
 }
 
+// Calls run(first, end) for each maximal stretch [first, end) of missing pixels along one line of
+// an image: the n pixels depth_m[start + k step], k = 0 .. n - 1 (a row: step 1; a column: step
+// width).
+template <class Run>
+void ForEachMissingRun(const std::vector<float>& depth_m, size_t start, size_t step, int n,
+                       Run run) {
+  for (int k = 0; k < n;) {
+    if (ValidDepth(depth_m[start + k * step])) {
+      ++k;
+      continue;
+    }
+    const int first = k;
+    while (k < n && !ValidDepth(depth_m[start + k * step])) ++k;
+    run(first, k);
+  }
+}
+
 std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int width, int height,
                                           const ErrorStructureOptions& options,
                                           std::vector<double>* shadow_runs,
@@ -133,13 +150,7 @@ std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int
   std::vector<MissingClass> classes(depth_m.size(), MissingClass::kValid);
   for (int v = 0; v < height; ++v) {
     const size_t row = static_cast<size_t>(v) * width;
-    for (int u = 0; u < width;) {
-      if (ValidDepth(depth_m[row + u])) {
-        ++u;
-        continue;
-      }
-      const int first = u;
-      while (u < width && !ValidDepth(depth_m[row + u])) ++u;
+    ForEachMissingRun(depth_m, row, 1, width, [&](int first, int u) {
       const double length = u - first;
       MissingClass c;
       if (first == 0 || u == width) {
@@ -160,9 +171,33 @@ std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int
         }
       }
       std::fill(classes.begin() + row + first, classes.begin() + row + u, c);
-    }
+    });
   }
   return classes;
+}
+
+std::vector<float> BandWidthsAcross(const std::vector<float>& depth_m, int width, int height) {
+  CheckDepthSize(depth_m, width, height);
+  const size_t pixels = static_cast<size_t>(width) * height;
+  std::vector<float> along_row(pixels, 0.0f), across(pixels, 0.0f);
+  for (int v = 0; v < height; ++v) {
+    const size_t row = static_cast<size_t>(v) * width;
+    ForEachMissingRun(depth_m, row, 1, width, [&](int first, int end) {
+      std::fill(along_row.begin() + row + first, along_row.begin() + row + end,
+                static_cast<float>(end - first));
+    });
+  }
+  for (int u = 0; u < width; ++u) {
+    ForEachMissingRun(depth_m, u, width, height, [&](int first, int end) {
+      const double c = end - first;
+      for (int k = first; k < end; ++k) {
+        const size_t p = static_cast<size_t>(k) * width + u;
+        const double r = along_row[p];
+        across[p] = static_cast<float>(1.0 / std::sqrt(1.0 / (r * r) + 1.0 / (c * c)));
+      }
+    });
+  }
+  return across;
 }
 
 NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
@@ -204,7 +239,8 @@ NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, i
   // ClassifyMissing gives every pixel of a run its run's class, and runs are separated by valid
   // pixels, so a run is a maximal stretch of one missing class.
   const std::vector<MissingClass> classes = ClassifyMissing(depth_m, width, height, options);
-  std::vector<double> shadow_runs, edge_runs;
+  const std::vector<float> across = BandWidthsAcross(depth_m, width, height);
+  std::vector<double> shadow_runs, edge_runs, shadow_across, edge_across;
   for (int v = 0; v < height; ++v) {
     const size_t row = static_cast<size_t>(v) * width;
     for (int u = 0; u < width;) {
@@ -213,14 +249,18 @@ NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, i
       bool touches = false;
       while (u < width && classes[row + u] == c) touches |= region[row + u++] != 0;
       if (!touches) continue;
-      if (c == MissingClass::kShadow) shadow_runs.push_back(u - first);
-      if (c == MissingClass::kEdge) edge_runs.push_back(u - first);
+      if (c != MissingClass::kShadow && c != MissingClass::kEdge) continue;
+      (c == MissingClass::kShadow ? shadow_runs : edge_runs).push_back(u - first);
+      std::vector<double>& widths = c == MissingClass::kShadow ? shadow_across : edge_across;
+      widths.insert(widths.end(), across.begin() + row + first, across.begin() + row + u);
     }
   }
   n.shadow_runs = static_cast<int>(shadow_runs.size());
   n.edge_runs = static_cast<int>(edge_runs.size());
   n.shadow_band_px = Median(shadow_runs);
   n.edge_band_px = Median(edge_runs);
+  n.shadow_band_across_px = Median(shadow_across);
+  n.edge_band_across_px = Median(edge_across);
   return n;
 }
 
@@ -284,6 +324,14 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   s.missing_low_signal = count[static_cast<int>(MissingClass::kLowSignal)] / pixels;
   s.shadow_band_px = Median(shadow_runs);
   s.edge_band_px = Median(edge_runs);
+  const std::vector<float> across = BandWidthsAcross(depth_m, width, height);
+  std::vector<double> shadow_across, edge_across;
+  for (size_t p = 0; p < classes.size(); ++p) {
+    if (classes[p] == MissingClass::kShadow) shadow_across.push_back(across[p]);
+    if (classes[p] == MissingClass::kEdge) edge_across.push_back(across[p]);
+  }
+  s.shadow_band_across_px = Median(shadow_across);
+  s.edge_band_across_px = Median(edge_across);
 
   const int n = options.patch_size;
   const int lags = n / 2;
@@ -382,6 +430,8 @@ nlohmann::json ToJson(const ErrorStructure& s) {
             {"low_signal", s.missing_low_signal}}},
           {"shadow_band_px", s.shadow_band_px},
           {"edge_band_px", s.edge_band_px},
+          {"shadow_band_across_px", s.shadow_band_across_px},
+          {"edge_band_across_px", s.edge_band_across_px},
           {"patches", s.patches},
           {"noise_over_model", s.noise_over_model},
           {"noise_over_model_by_incidence_0_20_40_60_deg", s.noise_over_model_by_incidence},
@@ -410,6 +460,8 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
        [](const ErrorStructure& s) { return 100 * s.missing_low_signal; }},
       {"shadow band width [px]", [](const ErrorStructure& s) { return s.shadow_band_px; }},
       {"edge band width [px]", [](const ErrorStructure& s) { return s.edge_band_px; }},
+      {"shadow band across [px]", [](const ErrorStructure& s) { return s.shadow_band_across_px; }},
+      {"edge band across [px]", [](const ErrorStructure& s) { return s.edge_band_across_px; }},
       {"small-patch noise / model", [](const ErrorStructure& s) { return s.noise_over_model; }},
       {"  ... incidence 0-20 deg",
        [](const ErrorStructure& s) { return s.noise_over_model_by_incidence[0]; }},
@@ -466,6 +518,28 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
   std::string table = line(first);
   for (const auto& row : rows) table += line(row);
   return table;
+}
+
+std::vector<float> ResampleDepthNearest(const std::vector<float>& depth_m,
+                                        const PinholeIntrinsics& from,
+                                        const PinholeIntrinsics& to) {
+  CheckDepthSize(depth_m, from.width, from.height);
+  if (!(from.fx > 0 && from.fy > 0 && to.fx > 0 && to.fy > 0) || to.width <= 0 ||
+      to.height <= 0) {
+    ThrowBadValue("intrinsics", "fx " + std::to_string(from.fx) + " -> " + std::to_string(to.fx),
+                  "positive focal lengths and image sizes");
+  }
+  std::vector<float> out(static_cast<size_t>(to.width) * to.height, 0.0f);
+  for (int v = 0; v < to.height; ++v) {
+    const long y = std::lround(from.cy + from.fy * (v - to.cy) / to.fy);
+    if (y < 0 || y >= from.height) continue;
+    for (int u = 0; u < to.width; ++u) {
+      const long x = std::lround(from.cx + from.fx * (u - to.cx) / to.fx);
+      if (x < 0 || x >= from.width) continue;
+      out[static_cast<size_t>(v) * to.width + u] = depth_m[static_cast<size_t>(y) * from.width + x];
+    }
+  }
+  return out;
 }
 
 RgbImage DepthSideBySide(const std::vector<const std::vector<float>*>& depths_m, int width,

@@ -13,7 +13,9 @@
 //    camera's occlusion and the correlation window straddling two surfaces);
 //  - range: both neighbours beyond far_m (the far end of the sensor's range);
 //  - low signal: the rest (dark, shiny, grazing, thin: the pattern did not come back).
-// Shadow and edge runs give the band widths (median run length beside a depth step).
+// Shadow and edge runs give the band widths (median run length beside a depth step), and the
+// widths across the band (BandWidthsAcross: the run along the row and the one along the column
+// through each pixel, combined so that a band's slant does not count).
 //
 // Residual autocorrelation. The image is tiled with patch_size windows; a fully valid window
 // seen at no more than max_incidence_deg gets a least-squares plane; windows whose residual sigma
@@ -55,6 +57,8 @@ struct ErrorStructure {
          missing_low_signal = 0;
   double shadow_band_px = 0;  // median length of shadow runs (NaN: none)
   double edge_band_px = 0;    // median length of edge runs (NaN: none)
+  // Median over the shadow (edge) pixels of BandWidthsAcross (NaN: none).
+  double shadow_band_across_px = 0, edge_band_across_px = 0;
   int patches = 0;
   // Median over patches of residual sigma / sqrt(sigma_z^2 + step^2 / 12) (AxialNoiseModel,
   // LatticeStep): the small-patch noise relative to the per-pixel model.
@@ -105,6 +109,14 @@ std::vector<MissingClass> ClassifyMissing(const std::vector<float>& depth_m, int
                                           std::vector<double>* shadow_runs = nullptr,
                                           std::vector<double>* edge_runs = nullptr);
 
+// The width across the missing band through each pixel, whatever the band's slant: a straight
+// band of width w at angle t to the rows has runs r = w / |sin t| along the row and
+// c = w / |cos t| along the column, and 1 / r^2 + 1 / c^2 = 1 / w^2, so
+// w = (r^-2 + c^-2)^(-1/2) (a vertical band: r; a horizontal one: c; a slant of 45 deg: r / sqrt 2).
+// Run lengths r and c count the missing pixels (any cause) in a row and in a column; the image's
+// sides end a run. Returns width x height values, 0 at valid pixels.
+std::vector<float> BandWidthsAcross(const std::vector<float>& depth_m, int width, int height);
+
 // Missing pixels around one object (issue 23's "comparable table-top scene": a real frame and
 // the same view rendered, the same object seen from the same place). The neighbourhood is the
 // object's mask (width x height, non-zero = object) grown by `radius_px` pixels (a square,
@@ -116,6 +128,8 @@ struct NeighbourhoodStructure {
   double pixels = 0;         // in the neighbourhood
   double missing_share = 0;  // of them
   double shadow_band_px = 0, edge_band_px = 0;  // NaN: no run
+  // Median over those runs' pixels of BandWidthsAcross (NaN: no run).
+  double shadow_band_across_px = 0, edge_band_across_px = 0;
   int shadow_runs = 0, edge_runs = 0;
 };
 NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
@@ -134,6 +148,14 @@ std::string FormatCauseTable(const std::vector<MissingClass>& classes,
 std::string FormatRealismTable(const std::vector<std::string>& names,
                                const std::vector<ErrorStructure>& structures, size_t reference,
                                const std::vector<size_t>& rendered);
+
+// A depth image seen through other intrinsics from the same place: each pixel of `to` takes
+// the `from` pixel nearest its ray (u_from = cx_from + fx_from (u - cx_to) / fx_to, rounded;
+// rows alike), 0 where that lies outside `from`; lens distortion is not modelled. For looking at
+// frames of different focal lengths side by side at the same scale.
+std::vector<float> ResampleDepthNearest(const std::vector<float>& depth_m,
+                                        const PinholeIntrinsics& from,
+                                        const PinholeIntrinsics& to);
 
 // Depth images side by side as one RGB image for a human to compare (grey by inverse depth
 // over [0.5, 4] m, near bright; missing pixels red); every image width x height.

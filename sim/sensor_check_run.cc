@@ -140,9 +140,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     report.like_for_like.push_back(
         {structured ? "view, SL" : "view, stat.", 1.0,
          AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx)});
-    report.view_depth_m[structured ? 2 : 1] = std::move(depth_m);
+    // The picture shows the rendered frame at the real one's scale and field of view.
+    report.view_depth_m[structured ? 2 : 1] =
+        ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
   }
-  if (width != view.width || height != view.height) report.view_width = 0;  // no picture
 }
 
 }  // namespace
@@ -245,6 +246,10 @@ std::string SensorCheckReport::FormatLikeForLike() const {
       [](const NeighbourhoodRow& r) { return r.structure.shadow_band_px * r.pixel_scale; });
   add("edge band [px]",
       [](const NeighbourhoodRow& r) { return r.structure.edge_band_px * r.pixel_scale; });
+  add("shadow band across [px]",
+      [](const NeighbourhoodRow& r) { return r.structure.shadow_band_across_px * r.pixel_scale; });
+  add("edge band across [px]",
+      [](const NeighbourhoodRow& r) { return r.structure.edge_band_across_px * r.pixel_scale; });
   std::snprintf(line, sizeof(line), "%-24s", "runs (shadow, edge)");
   text += line;
   for (const NeighbourhoodRow& row : like_for_like) {
@@ -285,6 +290,8 @@ nlohmann::json SensorCheckReport::ToJson() const {
                     {"missing_share", n.missing_share},
                     {"shadow_band_px", n.shadow_band_px * row.pixel_scale},
                     {"edge_band_px", n.edge_band_px * row.pixel_scale},
+                    {"shadow_band_across_px", n.shadow_band_across_px * row.pixel_scale},
+                    {"edge_band_across_px", n.edge_band_across_px * row.pixel_scale},
                     {"shadow_runs", n.shadow_runs},
                     {"edge_runs", n.edge_runs}});
   }

@@ -78,7 +78,9 @@ struct SensorCheckReport {
     NeighbourhoodStructure structure;
   };
   std::vector<NeighbourhoodRow> like_for_like;
-  // Their depth images for sensor_check_view.png (real, statistical, structured light).
+  // Their depth images for sensor_check_view.png (real, statistical, structured light), the
+  // rendered ones resampled to the real frame's intrinsics (ResampleDepthNearest): the same scale
+  // and field of view.
   int view_width = 0, view_height = 0;
   std::vector<float> view_depth_m[3];
 

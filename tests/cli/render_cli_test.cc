@@ -190,7 +190,13 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
     EXPECT_GT(row["missing_share"].get<double>(), 0.01) << row.dump();
     EXPECT_GT(row["edge_runs"].get<int>(), 10) << row.dump();
     EXPECT_GT(row["shadow_runs"].get<int>(), 10) << row.dump();
+    // Widths across the bands (BandWidthsAcross): at least a pixel, at most the neighbourhood.
+    for (const char* key : {"shadow_band_across_px", "edge_band_across_px"}) {
+      EXPECT_GE(row[key].get<double>(), 1.0) << key << " " << row.dump();
+      EXPECT_LE(row[key].get<double>(), 21.0) << key << " " << row.dump();
+    }
   }
+  EXPECT_THAT(r.output, HasSubstr("edge band across [px]"));
   // The statistical sensor's holes are rules; the structured light's beside the object come from
   // the matching and so are more (measured 8.5 and 10.3 %, real 12.3 %).
   EXPECT_GT(like[2]["missing_share"].get<double>(), like[1]["missing_share"].get<double>());

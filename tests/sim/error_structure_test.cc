@@ -46,6 +46,77 @@ TEST(ErrorStructure, MissingRunsAreClassifiedByTheirNeighbours) {
   EXPECT_DOUBLE_EQ(s.missing_range, 40 * 4 / pixels);
   EXPECT_DOUBLE_EQ(s.shadow_band_px, 6);
   EXPECT_DOUBLE_EQ(s.edge_band_px, 3);
+  // The bands run the whole 200 rows (column runs of 200): across them nearly their row runs.
+  EXPECT_NEAR(s.shadow_band_across_px, 6 / std::sqrt(1 + 36.0 / (200 * 200)), 1e-5);
+  EXPECT_NEAR(s.edge_band_across_px, 3 / std::sqrt(1 + 9.0 / (200 * 200)), 1e-5);
+}
+
+// The width across a band is its perpendicular width whatever its slant; brute force against
+// the formula on bands drawn at several angles.
+TEST(ErrorStructure, BandWidthsAcrossDoNotDependOnTheBandsSlant) {
+  // A band of 4 px across, drawn as the pixels within 2 px of a line through the image's
+  // centre at angle t (a wall at 2 m elsewhere): along rows its runs are about 4 / |sin t|, along
+  // columns 4 / |cos t|.
+  for (const double degrees : {90.0, 60.0, 45.0, 30.0, 10.0, 0.0}) {
+    const double t = degrees * M_PI / 180;
+    std::vector<float> depth(kWidth * kHeight, 2.0f);
+    for (int v = 0; v < kHeight; ++v) {
+      for (int u = 0; u < kWidth; ++u) {
+        const double x = u - (kWidth - 1) / 2.0, y = v - (kHeight - 1) / 2.0;
+        if (std::abs(-std::sin(t) * x + std::cos(t) * y) < 2.0) depth[v * kWidth + u] = 0;
+      }
+    }
+    const std::vector<float> across = BandWidthsAcross(depth, kWidth, kHeight);
+    // Away from the image's sides, where the band is cut short.
+    std::vector<double> inner;
+    for (int v = 60; v < kHeight - 60; ++v) {
+      for (int u = 100; u < kWidth - 100; ++u) {
+        if (depth[v * kWidth + u] == 0) inner.push_back(across[v * kWidth + u]);
+      }
+    }
+    ASSERT_FALSE(inner.empty()) << degrees;
+    std::sort(inner.begin(), inner.end());
+    const double median = inner[inner.size() / 2];
+    EXPECT_NEAR(median, 4.0, 0.6) << degrees << " deg";
+    // The run along the row alone grows as 1 / sin t: 23 px at 10 deg.
+  }
+  // Exact values on a small image: a 2 x 3 hole gives 1 / sqrt(1/9 + 1/4) at each pixel; valid
+  // pixels 0; a hole through the whole image counts the image's side as its end.
+  std::vector<float> small(5 * 4, 1.0f);
+  for (int v = 1; v < 3; ++v) {
+    for (int u = 1; u < 4; ++u) small[v * 5 + u] = 0;
+  }
+  const std::vector<float> w = BandWidthsAcross(small, 5, 4);
+  EXPECT_FLOAT_EQ(w[1 * 5 + 2], static_cast<float>(1 / std::sqrt(1.0 / 9 + 1.0 / 4)));
+  EXPECT_EQ(w[0], 0.0f);
+  EXPECT_THROW(BandWidthsAcross(small, 4, 4), InputError);
+}
+
+TEST(ErrorStructure, ResamplingKeepsEachRaysDepth) {
+  // A 64 x 48 image at f 50 whose depth encodes the ray (1 + column + 100 row), seen through a
+  // camera of twice the focal length and the same size: each of its pixels shows the source
+  // pixel nearest its ray, the middle half of the source twice as large.
+  const PinholeIntrinsics from{64, 48, 50.0, 50.0, 31.5, 23.5};
+  const PinholeIntrinsics to{64, 48, 100.0, 100.0, 31.5, 23.5};
+  std::vector<float> depth(64 * 48);
+  for (int v = 0; v < 48; ++v) {
+    for (int u = 0; u < 64; ++u) depth[v * 64 + u] = 1.0f + u + 100.0f * v;
+  }
+  const std::vector<float> out = ResampleDepthNearest(depth, from, to);
+  ASSERT_EQ(out.size(), depth.size());
+  for (int v = 0; v < 48; ++v) {
+    for (int u = 0; u < 64; ++u) {
+      const long x = std::lround(31.5 + (u - 31.5) / 2), y = std::lround(23.5 + (v - 23.5) / 2);
+      ASSERT_EQ(out[v * 64 + u], depth[y * 64 + x]) << u << "," << v;
+    }
+  }
+  // The other way the wider view reaches beyond the source: 0 (missing) there.
+  const std::vector<float> wide = ResampleDepthNearest(depth, to, from);
+  EXPECT_EQ(wide[0], 0.0f);
+  EXPECT_EQ(wide[24 * 64 + 32], depth[std::lround(23.5 + 2 * 0.5) * 64 + std::lround(31.5 + 2 * 0.5)]);
+  EXPECT_THROW(ResampleDepthNearest(depth, from, PinholeIntrinsics{64, 48, 0.0, 50.0, 31.5, 23.5}),
+               InputError);
+  EXPECT_THROW(ResampleDepthNearest(std::vector<float>(10), from, to), InputError);
 }
 
 // A tilted plane plus noise: white, or averaged over 3 x 3 pixels (neighbours share 6 of 9
@@ -200,6 +271,11 @@ TEST(ErrorStructure, NeighbourhoodCountsTheObjectsGrownMaskAndTheRunsTouchingIt)
   EXPECT_EQ(n.edge_runs, 20);
   EXPECT_DOUBLE_EQ(n.shadow_band_px, 4.0);  // whole runs, not their part inside
   EXPECT_DOUBLE_EQ(n.edge_band_px, 4.0);    // median of ten 6s and ten 2s
+  // Across: the runs are 20 rows tall (column runs of 20, or of 10 where the edge run is 6 wide
+  // and the rows 60-69 have no pixel there); pixel medians.
+  EXPECT_NEAR(n.shadow_band_across_px, 1 / std::sqrt(1 / 16.0 + 1 / 400.0), 1e-5);
+  // Edge pixels: 20 at (6 x 20), 40 at (6 x 10), 20 at (2 x 20); the middle ones are (6 x 10).
+  EXPECT_NEAR(n.edge_band_across_px, 1 / std::sqrt(1 / 36.0 + 1 / 100.0), 1e-5);
   // Radius 0: the mask itself, nothing missing in it, but the runs beside it do not touch it.
   const NeighbourhoodStructure inside = AnalyseNeighbourhood(depth, kWidth, kHeight, mask, 0);
   EXPECT_DOUBLE_EQ(inside.pixels, 400.0);
