@@ -65,7 +65,7 @@ struct StructuredLightOptions {
   // pixels away scoring above ambiguity_ratio times the best, or a peak on the search range's end.
   int window_px = 9;
   int search_px = 2;
-  double min_correlation = 0.5;
+  double min_correlation = 0.55;
   double min_contrast = 0.005;
   double ambiguity_ratio = 0.95;
   // Diagnostics (docs/tracker.md, "Structured-light frames"), both true on a real device:

@@ -382,7 +382,8 @@ TEST(ProxyTrackerTest, ALossIsReacquiredFromThePoseBeforeIt) {
 
 // A story take (`config_file`: configs/soldier.json or configs/mario.json, participant 0) on
 // structured-light frames with the camera at 0.85 m (docs/tracker.md, "Losses and flips at
-// 0.85 m").
+// 0.85 m"), matched with min_correlation 0.5: the moments the tests below replay (a twin verified
+// at one frame) were found on those frames, and another threshold makes other frames.
 test_take::SimTake StructuredLightStoryTake(const std::string& config_file, int take_index,
                                             int* take_frames) {
   const std::filesystem::path dir = testing::TempDir() + "structured_light_story";
@@ -392,6 +393,7 @@ test_take::SimTake StructuredLightStoryTake(const std::string& config_file, int 
   config["sensor"]["mode"] = "structured_light";
   config["camera"]["y"] = -0.65;
   config["camera"]["z"] = 0.55;
+  config["sensor"]["structured_light"]["min_correlation"] = 0.5;
   const std::filesystem::path file = dir / std::filesystem::path(config_file).filename();
   std::ofstream(file) << config.dump();
   return test_take::SoldierStorySession(MMH_SOURCE_DIR, 0, take_index,
