@@ -529,14 +529,20 @@ std::vector<float> ResampleDepthNearest(const std::vector<float>& depth_m,
     ThrowBadValue("intrinsics", "fx " + std::to_string(from.fx) + " -> " + std::to_string(to.fx),
                   "positive focal lengths and image sizes");
   }
+  // The source column of every target column, the same in every row (-1: outside).
+  std::vector<long> source_column(to.width);
+  for (int u = 0; u < to.width; ++u) {
+    const long x = std::lround(from.cx + from.fx * (u - to.cx) / to.fx);
+    source_column[u] = x >= 0 && x < from.width ? x : -1;
+  }
   std::vector<float> out(static_cast<size_t>(to.width) * to.height, 0.0f);
   for (int v = 0; v < to.height; ++v) {
     const long y = std::lround(from.cy + from.fy * (v - to.cy) / to.fy);
     if (y < 0 || y >= from.height) continue;
     for (int u = 0; u < to.width; ++u) {
-      const long x = std::lround(from.cx + from.fx * (u - to.cx) / to.fx);
-      if (x < 0 || x >= from.width) continue;
-      out[static_cast<size_t>(v) * to.width + u] = depth_m[static_cast<size_t>(y) * from.width + x];
+      if (source_column[u] < 0) continue;
+      out[static_cast<size_t>(v) * to.width + u] =
+          depth_m[static_cast<size_t>(y) * from.width + source_column[u]];
     }
   }
   return out;
