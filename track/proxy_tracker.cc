@@ -315,11 +315,16 @@ bool ProxyTracker::Better(const Candidate& a, const std::optional<Candidate>& b,
     auto distance_to_prediction = [&](const Candidate& c) {
       return RotationAngle(c.icp.proxy_T_camera.Inverse().rotation, predicted->rotation);
     };
+    const double to_a = distance_to_prediction(a);
+    const double to_b = distance_to_prediction(*b);
+    // ... and only for a pose that continues the track (within 45 deg of the prediction): of two
+    // poses both far from it (the proxy turned while it was lost), neither does.
     const bool far = tracked_frames_ >= o.trusted_frames &&
+                     std::min(to_a, to_b) <= std::numbers::pi / 4 &&
                      RotationAngle(a.icp.proxy_T_camera.rotation, b->icp.proxy_T_camera.rotation) >
                          std::numbers::pi / 4;
     if (std::abs(a.Score() - b->Score()) <= (far ? o.far_switch_margin : o.switch_margin)) {
-      return distance_to_prediction(a) < distance_to_prediction(*b);
+      return to_a < to_b;
     }
   }
   return a.Score() > b->Score();
@@ -1027,8 +1032,9 @@ TrackFrameResult ProxyTracker::TrackUnfiltered(const RgbdFrame& frame) {
       // Extrapolate, slowing down: a hidden proxy is more likely to stop than to fly on.
       const Rigid3 coasted = motion_->Coast();
       ++predicted_frames_;
-      // Hidden, the proxy may be turned: continuity no longer tells it from its twins.
-      tracked_frames_ = 0;
+      // Hidden for longer than reacquire_trust_frames, the proxy may be turned: continuity no
+      // longer tells it from its twins.
+      if (predicted_frames_ > options_.detection.reacquire_trust_frames) tracked_frames_ = 0;
       result.status = TrackStatus::kPredicted;
       result.camera_T_proxy = coasted;
       result.reason = why;
