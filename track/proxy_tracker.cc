@@ -749,6 +749,7 @@ TrackFrameResult ProxyTracker::Lose(TrackFrameResult result, const std::string& 
     reacquire_pose_ = motion_->last();
     reacquire_age_ = 0;
     reacquire_tracked_frames_ = tracked_frames_;
+    reacquire_predicted_frames_ = predicted_frames_;
   } else if (reacquire_pose_ && ++reacquire_age_ >= options_.detection.reacquire_frames) {
     reacquire_pose_.reset();
   }
@@ -1003,9 +1004,10 @@ TrackFrameResult ProxyTracker::TrackUnfiltered(const RgbdFrame& frame) {
   bool held = false;
   if (!chosen && enough) {
     // After a loss, the pose before it seeds the detection and breaks its ties.
-    // ... and continues the track's trust (DetectionOptions::reacquire_trust_frames).
+    // ... and continues the track's trust (DetectionOptions::reacquire_trust_frames) when the
+    // whole gap, the frames predicted before the loss and the frames lost, is short enough.
     if (!predicted && reacquire_pose_ &&
-        reacquire_age_ < options_.detection.reacquire_trust_frames) {
+        reacquire_predicted_frames_ + reacquire_age_ < options_.detection.reacquire_trust_frames) {
       tracked_frames_ = reacquire_tracked_frames_;
     }
     chosen = DetectAfterLoss(frame, predicted ? predicted : reacquire_pose_, &result, &why, &held);

@@ -146,7 +146,8 @@ struct DetectionOptions {
   // short gaps"). A proxy may turn while it is lost, and the hold refuses a pose more than 135 deg
   // from the one before the loss: the stories' fastest turn is 120 deg in 4 frames (a loss of 3
   // frames and the frame after it) and 135 deg in 5. A proxy hidden (too few points, predicted)
-  // for up to as many frames keeps the trust too.
+  // for up to as many frames keeps the trust too; predicted frames followed by lost ones are one
+  // gap, and the trust spans at most this many frames of it in all.
   int reacquire_trust_frames = 3;
 
   template <class V>
@@ -482,6 +483,7 @@ class ProxyTracker {
   std::optional<Rigid3> reacquire_pose_;
   int reacquire_age_ = 0;
   int reacquire_tracked_frames_ = 0;
+  int reacquire_predicted_frames_ = 0;  // frames predicted just before the loss: the same gap
   // The exponential average of the tracked poses' scores (the slide check's reference); nullopt
   // after a loss.
   std::optional<double> recent_score_;

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -380,6 +381,52 @@ TEST(ProxyTrackerTest, ALossIsReacquiredFromThePoseBeforeIt) {
   EXPECT_NE(error.find("tracker.detection.reacquire_frames"), std::string::npos) << error;
 }
 
+// The demo walk, with the Soldier turned 150 deg about the table's normal from frame `turn` on
+// (30 frames a second).
+std::function<Rigid3(double)> WalkTurnedFrom(int turn) {
+  return [turn](double t) {
+    const Rigid3 walk = sim::DemoMotionOptions().TableTProxy(t);
+    if (std::lround(t * 30.0) < turn) return walk;
+    const Eigen::Quaterniond half(Eigen::AngleAxisd(150 * M_PI / 180, Eigen::Vector3d::UnitZ()));
+    return Rigid3(half * walk.rotation, walk.translation);
+  };
+}
+
+// Tracks frames 0 … count-1 of `take` (each must be tracked); the last pose in *last.
+void TrackFrames(ProxyTracker& tracker, test_take::SimTake& take, int count, Rigid3* last) {
+  for (int i = 0; i < count; ++i) {
+    const TrackFrameResult result = tracker.Track(take.Render(i));
+    ASSERT_EQ(result.status, TrackStatus::kTracked) << "frame " << i;
+    *last = result.camera_T_proxy;
+  }
+}
+
+// Frames first … end-1 of `take` without depth: each must be lost.
+void LoseFrames(ProxyTracker& tracker, test_take::SimTake& take, int first, int end) {
+  for (int i = first; i < end; ++i) {
+    RgbdFrame frame = take.Render(i);
+    std::fill(frame.depth.begin(), frame.depth.end(), uint16_t{0});
+    ASSERT_EQ(tracker.Track(frame).status, TrackStatus::kLost) << "frame " << i;
+  }
+}
+
+// The re-detection after a gap, from the track's last pose `before`: a trusted track keeps the
+// pose 30 deg from it over the better one 150 deg away (the truth); a fresh one takes the truth.
+void ExpectReacquisition(const TrackFrameResult& after, const Rigid3& before, const Rigid3& truth,
+                         bool trusted) {
+  ASSERT_EQ(after.status, TrackStatus::kTracked) << after.reason;
+  EXPECT_TRUE(after.detected);
+  const double to_truth = RotationAngle(after.camera_T_proxy.rotation, truth.rotation) * 180 / M_PI;
+  const double to_before =
+      RotationAngle(after.camera_T_proxy.rotation, before.rotation) * 180 / M_PI;
+  if (trusted) {
+    EXPECT_LT(to_before, 45.0);
+    EXPECT_GT(to_truth, 135.0);
+  } else {
+    EXPECT_LT(to_truth, 5.0);
+  }
+}
+
 // A gap of up to reacquire_trust_frames lost frames keeps the track's trust
 // (DetectionOptions::reacquire_trust_frames). The demo walk is tracked for 40 frames (trusted:
 // trusted_frames 30); then `gap` frames have no depth (lost); then the Soldier stands turned by
@@ -398,41 +445,54 @@ TEST(ProxyTrackerTest, AShortGapKeepsTheTrust) {
     const bool trusted = gap <= trust_frames;
     SCOPED_TRACE(std::to_string(gap) + " lost frames, reacquire_trust_frames " +
                  std::to_string(trust_frames));
-    auto table_T_proxy = [&](double t) {
-      const Rigid3 walk = sim::DemoMotionOptions().TableTProxy(t);
-      if (std::lround(t * 30.0) < kTracked + gap) return walk;
-      const Eigen::Quaterniond turn(Eigen::AngleAxisd(150 * M_PI / 180, Eigen::Vector3d::UnitZ()));
-      return Rigid3(turn * walk.rotation, walk.translation);
-    };
-    test_take::SimTake take(test_take::StatisticalConfig(), table_T_proxy);
+    test_take::SimTake take(test_take::StatisticalConfig(), WalkTurnedFrom(kTracked + gap));
     ASSERT_DOUBLE_EQ(take.config().sensor.frame_rate, 30.0);
     ProxyTrackerOptions options;
     options.detection.reacquire_trust_frames = trust_frames;
     ProxyTracker tracker(take.model(), "soldier", take.Setup(), options);
     Rigid3 before;
-    for (int i = 0; i < kTracked; ++i) {
-      const TrackFrameResult result = tracker.Track(take.Render(i));
-      ASSERT_EQ(result.status, TrackStatus::kTracked) << "frame " << i;
-      before = result.camera_T_proxy;
-    }
-    for (int i = kTracked; i < kTracked + gap; ++i) {
-      RgbdFrame frame = take.Render(i);
-      std::fill(frame.depth.begin(), frame.depth.end(), uint16_t{0});
-      ASSERT_EQ(tracker.Track(frame).status, TrackStatus::kLost) << "frame " << i;
-    }
+    ASSERT_NO_FATAL_FAILURE(TrackFrames(tracker, take, kTracked, &before));
+    ASSERT_NO_FATAL_FAILURE(LoseFrames(tracker, take, kTracked, kTracked + gap));
     Rigid3 truth;
     const TrackFrameResult after = tracker.Track(take.Render(kTracked + gap, &truth));
-    ASSERT_EQ(after.status, TrackStatus::kTracked) << after.reason;
-    EXPECT_TRUE(after.detected);
-    const double to_truth = RotationAngle(after.camera_T_proxy.rotation, truth.rotation) * 180 / M_PI;
-    const double to_before =
-        RotationAngle(after.camera_T_proxy.rotation, before.rotation) * 180 / M_PI;
-    if (trusted) {
-      EXPECT_LT(to_before, 45.0);
-      EXPECT_GT(to_truth, 135.0);
-    } else {
-      EXPECT_LT(to_truth, 5.0);
+    ExpectReacquisition(after, before, truth, trusted);
+  }
+}
+
+// Hidden frames (the proxy's pixels gone: too few points, predicted) and the lost frames after them
+// are one gap: the trust spans at most reacquire_trust_frames of them together. The demo walk is
+// tracked, then `hidden` frames lose the depth within 100 px of the proxy and `lost` frames all of
+// it, then the Soldier stands turned 150 deg (as in AShortGapKeepsTheTrust).
+TEST(ProxyTrackerTest, HiddenAndLostFramesAreOneGap) {
+  constexpr int kTracked = 40;
+  const int trust_frames = ProxyTrackerOptions().detection.reacquire_trust_frames;
+  for (const auto& [hidden, lost] : {std::pair{1, trust_frames - 1}, {2, trust_frames - 1}}) {
+    const int gap = hidden + lost;
+    const bool trusted = gap <= trust_frames;
+    SCOPED_TRACE(std::to_string(hidden) + " hidden and " + std::to_string(lost) + " lost frames");
+    test_take::SimTake take(test_take::StatisticalConfig(), WalkTurnedFrom(kTracked + gap));
+    ProxyTracker tracker(take.model(), "soldier", take.Setup(), {});
+    Rigid3 before;
+    ASSERT_NO_FATAL_FAILURE(TrackFrames(tracker, take, kTracked, &before));
+    for (int i = kTracked; i < kTracked + hidden; ++i) {
+      Rigid3 camera_T_proxy;
+      RgbdFrame frame = take.Render(i, &camera_T_proxy);
+      const PinholeIntrinsics& k = frame.depth_intrinsics;
+      const Eigen::Vector3d c = camera_T_proxy.translation;
+      const int u = static_cast<int>(k.fx * c.x() / c.z() + k.cx);
+      const int v = static_cast<int>(k.fy * c.y() / c.z() + k.cy);
+      for (int y = std::max(0, v - 100); y < std::min(k.height, v + 100); ++y) {
+        for (int x = std::max(0, u - 100); x < std::min(k.width, u + 100); ++x) {
+          frame.depth[static_cast<size_t>(y) * k.width + x] = 0;
+        }
+      }
+      const TrackFrameResult result = tracker.Track(frame);
+      ASSERT_EQ(result.status, TrackStatus::kPredicted) << "frame " << i << ": " << result.reason;
     }
+    ASSERT_NO_FATAL_FAILURE(LoseFrames(tracker, take, kTracked + hidden, kTracked + gap));
+    Rigid3 truth;
+    const TrackFrameResult after = tracker.Track(take.Render(kTracked + gap, &truth));
+    ExpectReacquisition(after, before, truth, trusted);
   }
 }
 
