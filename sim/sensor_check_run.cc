@@ -1,6 +1,7 @@
 #include "sim/sensor_check_run.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iterator>
 
@@ -129,6 +130,24 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   report.view_depth_m[0] = view.depth_m;
   report.view_width = view.width;
   report.view_height = view.height;
+  // The rendered sensor's pixel grid over the real camera's field of view (the same rays through
+  // the pixel centres, focal length `focal`), and that grid with every pixel shown as 2 x 2.
+  PinholeIntrinsics native = intrinsics;
+  native.width = static_cast<int>(std::lround(view.width * real_scale));
+  native.height = static_cast<int>(std::lround(view.height * real_scale));
+  native.cx = (view.intrinsics.cx + 0.5) * real_scale - 0.5;
+  native.cy = (view.intrinsics.cy + 0.5) * real_scale - 0.5;
+  PinholeIntrinsics shown = native;
+  shown.width = 2 * native.width;
+  shown.height = 2 * native.height;
+  shown.fx = 2 * native.fx;
+  shown.fy = 2 * native.fy;
+  shown.cx = 2 * (native.cx + 0.5) - 0.5;
+  shown.cy = 2 * (native.cy + 0.5) - 0.5;
+  report.native_view_width = shown.width;
+  report.native_view_height = shown.height;
+  report.native_view_depth_m[0] = ResampleDepthNearest(
+      ResampleDepthNearest(view.depth_m, view.intrinsics, native), native, shown);
   scene.SetFrame(table_T_object, 0.0);
   for (const SensorMode mode : {SensorMode::kStatistical, SensorMode::kStructuredLight}) {
     KinectSensorOptions options = config.sensor;
@@ -143,6 +162,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     // The picture shows the rendered frame at the real one's scale and field of view.
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
+    report.native_view_depth_m[structured ? 2 : 1] =
+        ResampleDepthNearest(ResampleDepthNearest(depth_m, intrinsics, native), native, shown);
   }
 }
 
@@ -317,6 +338,10 @@ void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::pa
                 DepthSideBySide({&report.view_depth_m[0], &report.view_depth_m[1],
                                  &report.view_depth_m[2]},
                                 report.view_width, report.view_height));
+    WriteRgbPng(out / "sensor_check_view_native.png",
+                DepthSideBySide({&report.native_view_depth_m[0], &report.native_view_depth_m[1],
+                                 &report.native_view_depth_m[2]},
+                                report.native_view_width, report.native_view_height));
   }
 }
 

@@ -83,6 +83,13 @@ struct SensorCheckReport {
   // and field of view.
   int view_width = 0, view_height = 0;
   std::vector<float> view_depth_m[3];
+  // The same three on the rendered sensor's pixel grid over the real camera's field of view (the
+  // real frame resampled down to it), each pixel shown as 2 x 2 (native_view_width x
+  // native_view_height): at the real frame's scale the rendered pixels are blocks and the real
+  // frame's, registered to a colour camera of twice the focal length, are not, which tells the
+  // frames apart by the resampling instead of the sensor.
+  int native_view_width = 0, native_view_height = 0;
+  std::vector<float> native_view_depth_m[3];
 
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
@@ -104,7 +111,8 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
 
 // Writes sensor_check.json and, when the frames have the same size, sensor_check.png (TUM,
 // statistical, structured light side by side) into `out`; with a like-for-like comparison also
-// sensor_check_view.png (the real frame, statistical, structured light).
+// sensor_check_view.png (the real frame, statistical, structured light) and
+// sensor_check_view_native.png (the same on the rendered sensor's pixel grid).
 void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out);
 
 }  // namespace mmh::sim

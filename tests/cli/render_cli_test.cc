@@ -181,6 +181,17 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // rendered sensor's pixels (its focal length 1066.8 px against 525).
   EXPECT_THAT(r.output, HasSubstr("like for like: around the object"));
   EXPECT_TRUE(fs::exists(dir_ / "sensor_check_view.png"));
+  // The same on the rendered sensor's grid: the real 640 x 480 view at 1066.8 px is 315 x 236
+  // pixels at 525 px, each shown as 2 x 2, three panels 8 px apart.
+  const std::string png = ReadBytes(dir_ / "sensor_check_view_native.png");
+  ASSERT_GT(png.size(), 24u);
+  auto big_endian = [&](size_t at) {
+    uint32_t value = 0;
+    for (size_t i = at; i < at + 4; ++i) value = value << 8 | static_cast<uint8_t>(png[i]);
+    return value;
+  };
+  EXPECT_EQ(big_endian(16), 3u * 630 + 2 * 8);
+  EXPECT_EQ(big_endian(20), 472u);
   const nlohmann::json like =
       nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"))["like_for_like"];
   ASSERT_EQ(like.size(), 3u);
