@@ -36,7 +36,9 @@ struct Setup {
 
   explicit Setup(bool structured_light = false) {
     config.scene.props = mmh::sim::TableProps::kCastle;
-    if (structured_light) config.sensor.mode = mmh::sim::SensorMode::kStructuredLight;
+    // Both modes set explicitly: structured light is the default since 2026-11-29.
+    config.sensor.mode = structured_light ? mmh::sim::SensorMode::kStructuredLight
+                                          : mmh::sim::SensorMode::kStatistical;
     scene = std::make_unique<mmh::sim::TableTopScene>(config, mmh::sim::LoadProxyModel("", 1.0));
     sensor = std::make_unique<mmh::sim::KinectSensor>(config.sensor, &scene->scene(),
                                                       scene->table_T_camera());

@@ -15,7 +15,7 @@ namespace mmh::sim {
 // How the sensor turns geometry into depth (config `sensor.mode`).
 enum class SensorMode {
   // The per-pixel model of docs/sensor.md (Nguyen et al. 2012 noise, edge and grazing rules):
-  // fast, the default.
+  // fast; the default until 2026-11-29 (docs/sensor.md: what each mode costs, when to use which).
   kStatistical,
   // Speckle pattern, IR image and block matching (StructuredLightOptions).
   kStructuredLight,
