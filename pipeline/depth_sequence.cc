@@ -63,9 +63,11 @@ sim::RealView ReadRealView(const std::filesystem::path& folder, const std::files
                       std::to_string(real.height));
   }
   real.mask.assign(real.depth_m.size(), 0);
+  real.others.assign(real.depth_m.size(), 0);
   size_t pixels = 0;
   for (size_t p = 0; p < real.mask.size(); ++p) {
     real.mask[p] = labels.rgb[3 * p] == object;
+    real.others[p] = labels.rgb[3 * p] != 0 && labels.rgb[3 * p] != object;
     pixels += real.mask[p];
   }
   if (pixels == 0) {

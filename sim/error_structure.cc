@@ -200,20 +200,17 @@ std::vector<float> BandWidthsAcross(const std::vector<float>& depth_m, int width
   return across;
 }
 
-NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
-                                            int height, std::span<const uint8_t> mask,
-                                            int radius_px, const ErrorStructureOptions& options) {
+std::vector<uint8_t> GrowMask(std::span<const uint8_t> mask, int width, int height,
+                              int radius_px) {
   const size_t pixels = static_cast<size_t>(width) * height;
-  if (depth_m.size() != pixels || mask.size() != pixels) {
-    ThrowBadValue("mask", std::to_string(mask.size()) + " pixels and " +
-                              std::to_string(depth_m.size()) + " depths",
-                  std::to_string(pixels) + " of each");
+  if (mask.size() != pixels) {
+    ThrowBadValue("mask", std::to_string(mask.size()) + " pixels", std::to_string(pixels));
   }
   if (radius_px < 0) ThrowBadValue("radius_px", std::to_string(radius_px), "0 or more");
-  // Grow the mask: along rows, then along columns (a square of side 2 radius + 1).
+  // Along rows, then along columns.
   std::vector<uint8_t> rows(pixels, 0), region(pixels, 0);
   for (int v = 0; v < height; ++v) {
-    int last = std::numeric_limits<int>::min() / 2;  // the last object pixel at or left of u
+    int last = std::numeric_limits<int>::min() / 2;  // the last mask pixel at or left of u
     for (int u = 0; u < width + radius_px; ++u) {
       if (u < width && mask[static_cast<size_t>(v) * width + u] != 0) last = u;
       const int target = u - radius_px;
@@ -227,6 +224,26 @@ NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, i
       const int target = v - radius_px;
       if (target >= 0 && v - last <= 2 * radius_px) region[static_cast<size_t>(target) * width + u] = 1;
     }
+  }
+  return region;
+}
+
+NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
+                                            int height, std::span<const uint8_t> mask,
+                                            int radius_px, const ErrorStructureOptions& options,
+                                            std::span<const uint8_t> excluded) {
+  const size_t pixels = static_cast<size_t>(width) * height;
+  if (depth_m.size() != pixels || mask.size() != pixels ||
+      (!excluded.empty() && excluded.size() != pixels)) {
+    ThrowBadValue("mask", std::to_string(mask.size()) + " pixels, " +
+                              std::to_string(excluded.size()) + " excluded and " +
+                              std::to_string(depth_m.size()) + " depths",
+                  std::to_string(pixels) + " of each (none excluded: 0)");
+  }
+  std::vector<uint8_t> region = GrowMask(mask, width, height, radius_px);
+  auto is_excluded = [&](size_t p) { return !excluded.empty() && excluded[p] != 0; };
+  for (size_t p = 0; p < pixels; ++p) {
+    if (is_excluded(p)) region[p] = 0;
   }
   NeighbourhoodStructure n;
   double missing = 0;
@@ -246,9 +263,12 @@ NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, i
     for (int u = 0; u < width;) {
       const MissingClass c = classes[row + u];
       const int first = u;
-      bool touches = false;
-      while (u < width && classes[row + u] == c) touches |= region[row + u++] != 0;
-      if (!touches) continue;
+      bool touches = false, left_out = false;
+      while (u < width && classes[row + u] == c) {
+        left_out |= is_excluded(row + u);
+        touches |= region[row + u++] != 0;
+      }
+      if (!touches || left_out) continue;
       if (c != MissingClass::kShadow && c != MissingClass::kEdge) continue;
       (c == MissingClass::kShadow ? shadow_runs : edge_runs).push_back(u - first);
       std::vector<double>& widths = c == MissingClass::kShadow ? shadow_across : edge_across;

@@ -132,10 +132,18 @@ struct NeighbourhoodStructure {
   double shadow_band_across_px = 0, edge_band_across_px = 0;
   int shadow_runs = 0, edge_runs = 0;
 };
+// `excluded` (empty, or width x height, non-zero = left out): pixels taken out of the
+// neighbourhood, and runs with a pixel there not counted: the parts of a real frame near objects
+// the rendered view does not hold.
 NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
                                             int height, std::span<const uint8_t> mask,
                                             int radius_px,
-                                            const ErrorStructureOptions& options = {});
+                                            const ErrorStructureOptions& options = {},
+                                            std::span<const uint8_t> excluded = {});
+
+// The mask (width x height, non-zero = in) grown by radius_px pixels: a square of side
+// 2 radius_px + 1 around each pixel in it (Chebyshev distance). Returns 0 / 1 per pixel.
+std::vector<uint8_t> GrowMask(std::span<const uint8_t> mask, int width, int height, int radius_px);
 
 // The classes against a rendered frame's exact causes (KinectSensor::missing_causes), in % of all
 // pixels: how well the depth-image rules that classify real frames name the sensor's causes.

@@ -123,10 +123,28 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
                   "a depth image, its intrinsics and a mask of the same size");
   }
   const double real_scale = focal / view.intrinsics.fx;
+  const int real_radius = static_cast<int>(std::lround(kNeighbourhoodRadiusPx / real_scale));
   report.like_for_like.push_back(
       {view.name, real_scale,
-       AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask,
-                            static_cast<int>(std::lround(kNeighbourhoodRadiusPx / real_scale)))});
+       AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius)});
+  // Near the other objects (grown as the neighbourhood is), on the real grid and on the rendered
+  // one (the same rays).
+  std::vector<uint8_t> real_away, rendered_away;
+  if (!view.others.empty()) {
+    if (view.others.size() != view.mask.size()) {
+      ThrowBadValue(view.name + ": other objects' mask", std::to_string(view.others.size()),
+                    std::to_string(view.mask.size()) + " pixels (the frame's)");
+    }
+    real_away = GrowMask(view.others, view.width, view.height, real_radius);
+    const std::vector<float> away_m(real_away.begin(), real_away.end());
+    const std::vector<float> mapped = ResampleDepthNearest(away_m, view.intrinsics, intrinsics);
+    rendered_away.assign(mapped.size(), 0);
+    for (size_t p = 0; p < mapped.size(); ++p) rendered_away[p] = mapped[p] > 0.5f;
+    report.like_for_like_away.push_back(
+        {view.name, real_scale,
+         AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius, {},
+                              real_away)});
+  }
   report.view_depth_m[0] = view.depth_m;
   report.view_width = view.width;
   report.view_height = view.height;
@@ -159,6 +177,12 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     report.like_for_like.push_back(
         {structured ? "view, SL" : "view, stat.", 1.0,
          AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx)});
+    if (!rendered_away.empty()) {
+      report.like_for_like_away.push_back(
+          {structured ? "view, SL" : "view, stat.", 1.0,
+           AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx, {},
+                                rendered_away)});
+    }
     // The picture shows the rendered frame at the real one's scale and field of view.
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
@@ -237,25 +261,39 @@ std::string SensorCheckReport::Format() const {
 }
 
 std::string SensorCheckReport::FormatLikeForLike() const {
-  char line[200];
-  std::snprintf(line, sizeof(line),
+  char title[200];
+  std::snprintf(title, sizeof(title),
                 "\nlike for like: around the object (its mask grown by %d px), band widths in the "
                 "rendered sensor's pixels\n",
                 kNeighbourhoodRadiusPx);
-  std::string text = line;
+  std::string text = FormatNeighbourhoods(title, like_for_like);
+  if (!like_for_like_away.empty()) {
+    std::snprintf(title, sizeof(title),
+                  "\nlike for like, away from the other objects (the real frame's other labels "
+                  "grown by %d px, left out of both)\n",
+                  kNeighbourhoodRadiusPx);
+    text += FormatNeighbourhoods(title, like_for_like_away);
+  }
+  return text;
+}
+
+std::string SensorCheckReport::FormatNeighbourhoods(const std::string& title,
+                                                    const std::vector<NeighbourhoodRow>& rows) {
+  char line[200];
+  std::string text = title;
   std::snprintf(line, sizeof(line), "%-24s", "");
   text += line;
-  for (const NeighbourhoodRow& row : like_for_like) {
+  for (const NeighbourhoodRow& row : rows) {
     std::snprintf(line, sizeof(line), "%26s", row.name.c_str());
     text += line;
   }
   text += "     SL/real   goal\n";
-  const NeighbourhoodRow& real = like_for_like.front();
-  const NeighbourhoodRow& sl = like_for_like.back();
+  const NeighbourhoodRow& real = rows.front();
+  const NeighbourhoodRow& sl = rows.back();
   auto add = [&](const char* label, auto value) {
     std::snprintf(line, sizeof(line), "%-24s", label);
     text += line;
-    for (const NeighbourhoodRow& row : like_for_like) {
+    for (const NeighbourhoodRow& row : rows) {
       std::snprintf(line, sizeof(line), "%26.2f", value(row));
       text += line;
     }
@@ -273,7 +311,7 @@ std::string SensorCheckReport::FormatLikeForLike() const {
       [](const NeighbourhoodRow& r) { return r.structure.edge_band_across_px * r.pixel_scale; });
   std::snprintf(line, sizeof(line), "%-24s", "runs (shadow, edge)");
   text += line;
-  for (const NeighbourhoodRow& row : like_for_like) {
+  for (const NeighbourhoodRow& row : rows) {
     std::snprintf(line, sizeof(line), "%26s",
                   (std::to_string(row.structure.shadow_runs) + ", " +
                    std::to_string(row.structure.edge_runs))
@@ -302,25 +340,29 @@ nlohmann::json SensorCheckReport::ToJson() const {
     }
     temporal_json.push_back({{"sequence", row.name}, {"lags", lags}});
   }
-  nlohmann::json like = nlohmann::json::array();
-  for (const NeighbourhoodRow& row : like_for_like) {
-    const NeighbourhoodStructure& n = row.structure;
-    like.push_back({{"frame", row.name},
-                    {"pixel_scale", row.pixel_scale},
-                    {"pixels", n.pixels},
-                    {"missing_share", n.missing_share},
-                    {"shadow_band_px", n.shadow_band_px * row.pixel_scale},
-                    {"edge_band_px", n.edge_band_px * row.pixel_scale},
-                    {"shadow_band_across_px", n.shadow_band_across_px * row.pixel_scale},
-                    {"edge_band_across_px", n.edge_band_across_px * row.pixel_scale},
-                    {"shadow_runs", n.shadow_runs},
-                    {"edge_runs", n.edge_runs}});
-  }
+  auto neighbourhoods = [](const std::vector<NeighbourhoodRow>& rows) {
+    nlohmann::json like = nlohmann::json::array();
+    for (const NeighbourhoodRow& row : rows) {
+      const NeighbourhoodStructure& n = row.structure;
+      like.push_back({{"frame", row.name},
+                      {"pixel_scale", row.pixel_scale},
+                      {"pixels", n.pixels},
+                      {"missing_share", n.missing_share},
+                      {"shadow_band_px", n.shadow_band_px * row.pixel_scale},
+                      {"edge_band_px", n.edge_band_px * row.pixel_scale},
+                      {"shadow_band_across_px", n.shadow_band_across_px * row.pixel_scale},
+                      {"edge_band_across_px", n.edge_band_across_px * row.pixel_scale},
+                      {"shadow_runs", n.shadow_runs},
+                      {"edge_runs", n.edge_runs}});
+    }
+    return like;
+  };
   return {{"columns", j},
           {"rendered_frames", frames},
           {"error_structure", error_structure},
           {"temporal_correlation", temporal_json},
-          {"like_for_like", like}};
+          {"like_for_like", neighbourhoods(like_for_like)},
+          {"like_for_like_away", neighbourhoods(like_for_like_away)}};
 }
 
 void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out) {

@@ -36,6 +36,9 @@ struct RealView {
   PinholeIntrinsics intrinsics;
   std::vector<float> depth_m;  // the real frame [m], width x height row-major, 0 = missing
   std::vector<uint8_t> mask;   // the object's pixels in it (its label image), non-zero = object
+  // The other labelled objects' pixels (non-zero), which the rendered view does not hold; empty:
+  // none known.
+  std::vector<uint8_t> others;
   RenderConfig config;
 };
 
@@ -78,6 +81,11 @@ struct SensorCheckReport {
     NeighbourhoodStructure structure;
   };
   std::vector<NeighbourhoodRow> like_for_like;
+  // The same, away from the other objects: their pixels grown by kNeighbourhoodRadiusPx (in the
+  // real frame's proportion) left out of both frames' neighbourhoods (AnalyseNeighbourhood's
+  // `excluded`, mapped to the rendered frames by ResampleDepthNearest). Empty without
+  // RealView::others.
+  std::vector<NeighbourhoodRow> like_for_like_away;
   // Their depth images for sensor_check_view.png (real, statistical, structured light), the
   // rendered ones resampled to the real frame's intrinsics (ResampleDepthNearest): the same scale
   // and field of view.
@@ -94,6 +102,8 @@ struct SensorCheckReport {
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
   std::string FormatLikeForLike() const;
+  static std::string FormatNeighbourhoods(const std::string& title,
+                                          const std::vector<NeighbourhoodRow>& rows);
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };

@@ -180,6 +180,8 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // modes, each with the object found and runs beside it; the real frame's bands scaled to the
   // rendered sensor's pixels (its focal length 1066.8 px against 525).
   EXPECT_THAT(r.output, HasSubstr("like for like: around the object"));
+  // ... and away from the other labelled objects (the mug and the foam brick beside the box).
+  EXPECT_THAT(r.output, HasSubstr("like for like, away from the other objects"));
   EXPECT_TRUE(fs::exists(dir_ / "sensor_check_view.png"));
   // The same on the rendered sensor's grid: the real 640 x 480 view at 1066.8 px is 315 x 236
   // pixels at 525 px, each shown as 2 x 2, three panels 8 px apart.
@@ -195,6 +197,13 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   const nlohmann::json like =
       nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"))["like_for_like"];
   ASSERT_EQ(like.size(), 3u);
+  const nlohmann::json away =
+      nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"))["like_for_like_away"];
+  ASSERT_EQ(away.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LT(away[k]["pixels"].get<double>(), like[k]["pixels"].get<double>()) << away[k].dump();
+    EXPECT_GT(away[k]["pixels"].get<double>(), 0.5 * like[k]["pixels"].get<double>());
+  }
   EXPECT_NEAR(like[0]["pixel_scale"].get<double>(), 525.0 / 1066.778, 1e-3);
   for (const auto& row : like) {
     EXPECT_GT(row["pixels"].get<double>(), 1000) << row.dump();

@@ -288,6 +288,27 @@ TEST(ErrorStructure, NeighbourhoodCountsTheObjectsGrownMaskAndTheRunsTouchingIt)
   EXPECT_THROW(AnalyseNeighbourhood(depth, kWidth, kHeight, std::vector<uint8_t>(10), 3),
                InputError);
   EXPECT_THROW(AnalyseNeighbourhood(depth, kWidth, kHeight, mask, -1), InputError);
+  // Left out: columns [121, 130) of rows [50, 60), where another object would stand. Its 20
+  // pixels inside the grown mask do not count, nor do the 6-px edge runs that reach into it; the
+  // runs beside it (rows 60-69) still do.
+  std::vector<uint8_t> excluded(depth.size(), 0);
+  for (int v = 50; v < 60; ++v) {
+    for (int u = 121; u < 130; ++u) excluded[v * kWidth + u] = 1;
+  }
+  const NeighbourhoodStructure away =
+      AnalyseNeighbourhood(depth, kWidth, kHeight, mask, 3, {}, excluded);
+  EXPECT_DOUBLE_EQ(away.pixels, 26.0 * 26.0 - 20);
+  EXPECT_DOUBLE_EQ(away.missing_share, (20.0 * 3 + 10.0 * 1 + 10.0 * 2) / (26.0 * 26.0 - 20));
+  EXPECT_EQ(away.shadow_runs, 20);
+  EXPECT_EQ(away.edge_runs, 10);
+  EXPECT_DOUBLE_EQ(away.edge_band_px, 2.0);
+  EXPECT_THROW(AnalyseNeighbourhood(depth, kWidth, kHeight, mask, 3, {}, std::vector<uint8_t>(10)),
+               InputError);
+  // GrowMask: the square of side 2 r + 1 around each pixel, clipped to the image.
+  const std::vector<uint8_t> grown = GrowMask(mask, kWidth, kHeight, 3);
+  EXPECT_EQ(std::count(grown.begin(), grown.end(), uint8_t{1}), 26 * 26);
+  EXPECT_EQ(grown[47 * kWidth + 97], 1);
+  EXPECT_EQ(grown[46 * kWidth + 97], 0);
 }
 
 TEST(ErrorStructure, BadInputNamesTheField) {
