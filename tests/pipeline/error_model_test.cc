@@ -543,7 +543,17 @@ TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
   // 1 % on the translation). By moments alone the translation sd is 6-16 % too large.
   EXPECT_NEAR(fit.rotation_sd, options.rotation_sd, 0.015 * options.rotation_sd);
   EXPECT_NEAR(fit.translation_sd, options.translation_sd, 0.015 * options.translation_sd);
-  EXPECT_NEAR(fit.correlation, options.correlation, 0.02);
+  // The core's time scales: what the data identify is the autocorrelation, here at lag 1 (over
+  // 12 seeds of these takes, 2026-11-30, within 0.007 of the defaults'). The fast part's ρ_f
+  // alone trades off against the slow part (w, ρ_s): over the same seeds it came back
+  // 0.132 ± 0.005 (sd) against the defaults' 0.147, with w and ρ_s a little larger to
+  // compensate, so it is held to that bias and 4 sd. (Until 2026-11-30 ρ_f was held to 0.02:
+  // seed 700 passed at the previous defaults, 0.144, and failed at these, 0.124.)
+  auto lag_one = [](const ErrorModelOptions& m) {
+    return m.slow_share * m.slow_correlation + (1 - m.slow_share) * m.correlation;
+  };
+  EXPECT_NEAR(lag_one(fit), lag_one(options), 0.02);
+  EXPECT_NEAR(fit.correlation, options.correlation, 0.015 + 4 * 0.005);
   // Pooled over the frames: Σ_c rate_c · at-risk frames is the expected number of starts.
   double expected = 0, fitted = 0;
   for (int c = 0; c < kViewConditions; ++c) {
