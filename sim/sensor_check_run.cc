@@ -164,8 +164,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   shown.cy = 2 * (native.cy + 0.5) - 0.5;
   report.native_view_width = shown.width;
   report.native_view_height = shown.height;
-  report.native_view_depth_m[0] = ResampleDepthNearest(
-      ResampleDepthNearest(view.depth_m, view.intrinsics, native), native, shown);
+  auto on_native_grid = [&](const std::vector<float>& depth_m, const PinholeIntrinsics& from) {
+    return ResampleDepthNearest(ResampleDepthNearest(depth_m, from, native), native, shown);
+  };
+  report.native_view_depth_m[0] = on_native_grid(view.depth_m, view.intrinsics);
   scene.SetFrame(table_T_object, 0.0);
   for (const SensorMode mode : {SensorMode::kStatistical, SensorMode::kStructuredLight}) {
     KinectSensorOptions options = config.sensor;
@@ -186,8 +188,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     // The picture shows the rendered frame at the real one's scale and field of view.
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
-    report.native_view_depth_m[structured ? 2 : 1] =
-        ResampleDepthNearest(ResampleDepthNearest(depth_m, intrinsics, native), native, shown);
+    report.native_view_depth_m[structured ? 2 : 1] = on_native_grid(depth_m, intrinsics);
   }
 }
 
