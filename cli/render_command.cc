@@ -64,6 +64,7 @@ struct SensorCheckArgs {
   // Like for like (docs/sensor.md): the sequence's first frame beside the same view rendered.
   std::string view, view_model, view_trajectory, view_label;
   int view_object = 8;
+  int patterns = 8;
   int frames = 3;
 };
 
@@ -91,6 +92,7 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
     }
     view = pipeline::ReadRealView(args.sequence, args.view_label, args.view_object, args.view,
                                   args.view_model, trajectory, render.sensor);
+    view->patterns = args.patterns;
   }
   const sim::SensorCheckReport report =
       sim::RunSensorCheck(args.data, render, args.frames, sequence ? &*sequence : nullptr,
@@ -154,6 +156,11 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
                   "Label image of the sequence's first frame (8-bit, YCB-Video -label.png)")
       ->capture_default_str();
   cmd->add_option("--view-object", args->view_object, "The object's value in the label image")
+      ->capture_default_str();
+  cmd->add_option("--patterns", args->patterns,
+                  "Speckle patterns the view is rendered with in structured light (the config's "
+                  "pattern_seed and the next ones): the like-for-like ratios' mean and spread")
+      ->check(CLI::Range(1, 100))
       ->capture_default_str();
   cmd->add_option("--frames", args->frames, "Rendered frames to analyse")
       ->check(CLI::Range(1, 1000));

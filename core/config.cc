@@ -74,6 +74,16 @@ ConfigSource Config::SourceOf(const std::string& key_path) const {
   return ConfigSource{name};
 }
 
+std::filesystem::path Config::FolderOf(const std::string& key_path) const {
+  for (const auto& [key, assignment] : overrides_) {
+    if (key == key_path || key.rfind(key_path + ".", 0) == 0 || key_path.rfind(key + ".", 0) == 0) {
+      return {};
+    }
+  }
+  if (file_.empty()) return {};
+  return std::filesystem::path(file_).parent_path();
+}
+
 void Config::RequireOnlySections(const std::vector<std::string>& sections) const {
   for (auto it = root_.begin(); it != root_.end(); ++it) {
     bool known = false;

@@ -45,6 +45,11 @@ class Config {
   // Where the value of `key_path` (or the object it lies in) came from, for messages.
   ConfigSource SourceOf(const std::string& key_path) const;
 
+  // The folder that relative file paths in the value of `key_path` are relative to: the config
+  // file's folder when the file gave the value, "" (the working directory) when a --set at, above
+  // or below `key_path` did or there is no file.
+  std::filesystem::path FolderOf(const std::string& key_path) const;
+
  private:
   nlohmann::json root_ = nlohmann::json::object();
   std::string file_;

@@ -10,7 +10,9 @@
 // and gets ToJson (every default filled in: the resolved config) and FromJson (missing keys keep
 // their defaults, unknown keys and wrong types are InputErrors naming the source, key path, value
 // and expectation, with a did-you-mean suggestion). Supported field types: bool, integers,
-// floating point, std::string, enums with an EnumNames(E) overload, and nested Options structs.
+// floating point, std::string, enums with an EnumNames(E) overload, nested Options structs, and
+// std::vector of nested Options structs (a JSON array of objects; keys in messages as
+// "scene.objects[1].mesh").
 #pragma once
 
 #include <cmath>
@@ -64,6 +66,12 @@ concept HasFields = requires(T& t, FieldCollector& c) {
   t.VisitFields(c);
 };
 
+template <class T>
+struct IsFieldsVector : std::false_type {};
+template <class T>
+requires HasFields<T>
+struct IsFieldsVector<std::vector<T>> : std::true_type {};
+
 // The closest known name within edit distance 2, or "".
 std::string SuggestName(const std::string& unknown, const std::vector<std::string>& known);
 
@@ -89,6 +97,10 @@ struct ToJsonVisitor {
   void operator()(const char* name, T& field) {
     if constexpr (HasFields<T>) {
       (*json)[name] = ToJson(field);
+    } else if constexpr (IsFieldsVector<T>::value) {
+      nlohmann::json array = nlohmann::json::array();
+      for (const auto& element : field) array.push_back(ToJson(element));
+      (*json)[name] = std::move(array);
     } else if constexpr (NamedEnum<T>) {
       (*json)[name] = EnumName(field);
     } else {
@@ -102,6 +114,14 @@ void ReadValue(const nlohmann::json& value, const std::string& key, const Config
                T* field) {
   if constexpr (HasFields<T>) {
     FromJson(value, key, source, field);
+  } else if constexpr (IsFieldsVector<T>::value) {
+    // The array replaces the default list; each element starts from the element's defaults.
+    if (!value.is_array()) ThrowKeyError(source, key, value, "an array of objects");
+    T elements(value.size());
+    for (size_t i = 0; i < value.size(); ++i) {
+      FromJson(value[i], key + "[" + std::to_string(i) + "]", source, &elements[i]);
+    }
+    *field = std::move(elements);
   } else if constexpr (NamedEnum<T>) {
     std::vector<std::string> names;
     for (const auto& [e, name] : EnumNames(T{})) names.emplace_back(name);

@@ -19,6 +19,7 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
 // -label.png) holds `object`, and the view's render config from `view` (render_real_view.py's
 // output without paths) with `model` as the proxy and `trajectory` as its poses, rendered by
 // `sensor` (the sensor under test: the view file places things, it does not choose the sensor).
+// The view's scene.objects name their mesh files relative to the view file (as any config file).
 // InputError naming the file when the label image differs in size or holds no pixel of the
 // object, or when the view file has a sensor section.
 sim::RealView ReadRealView(const std::filesystem::path& folder, const std::filesystem::path& label,

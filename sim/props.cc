@@ -189,6 +189,16 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   CheckSize(prefix + ".tape_width", tape_width, 0.1);
   CheckSize(prefix + ".tape_thickness", tape_thickness, 0.01);
   materials.Validate(prefix + ".materials");
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const std::string key = prefix + ".objects[" + std::to_string(i) + "]";
+    objects[i].Validate(key);
+    for (size_t j = 0; j < i; ++j) {
+      if (objects[j].name == objects[i].name) {
+        ThrowBadValue(key + ".name", "\"" + objects[i].name + "\"",
+                      "a name no other object has (objects[" + std::to_string(j) + "] has it)");
+      }
+    }
+  }
   if (!std::isfinite(like_box_center_x)) {
     ThrowBadValue(prefix + ".like_box_center_x", FormatNumber(like_box_center_x), "a finite x [m]");
   }
@@ -250,6 +260,38 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
                   "a table deep enough for the castle behind the play area (table_depth >= " +
                       FormatNumber(play_area_depth + 2 * (kCastleGap + kCastleDepth)) + " m)");
   }
+}
+
+void SceneObject::Validate(const std::string& prefix) const {
+  if (name.empty()) ThrowBadValue(prefix + ".name", "\"\"", "a name for the object");
+  for (const char* reserved : kReservedObjectNames) {
+    if (name == reserved) {
+      ThrowBadValue(prefix + ".name", "\"" + name + "\"",
+                    "a name other than the scene's own objects' (floor, table, play_area_tape, "
+                    "like_box_tape, backdrop, castle, proxy, hand, slider)");
+    }
+  }
+  if (mesh.empty()) ThrowBadValue(prefix + ".mesh", "\"\"", "an OBJ, PLY or Duplo .json file");
+  if (!(scale > 0) || !std::isfinite(scale)) {
+    ThrowBadValue(prefix + ".scale", FormatNumber(scale), "a positive finite factor");
+  }
+  for (const auto& [key, value] : {std::pair{"x", x}, {"y", y}, {"z", z}}) {
+    if (!(std::abs(value) <= 100.0)) {
+      ThrowBadValue(prefix + "." + key, FormatNumber(value), "a finite position within 100 m");
+    }
+  }
+  const double norm = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
+  if (!(std::abs(norm - 1.0) <= 1e-3)) {
+    ThrowBadValue(prefix + ".qx, qy, qz, qw",
+                  FormatNumber(qx) + ", " + FormatNumber(qy) + ", " + FormatNumber(qz) + ", " +
+                      FormatNumber(qw) + " (norm " + FormatNumber(norm) + ")",
+                  "a unit quaternion (norm within 1e-3 of 1)");
+  }
+  material.Validate(prefix + ".material");
+}
+
+Rigid3 SceneObject::TableTObject() const {
+  return Rigid3(Eigen::Quaterniond(qw, qx, qy, qz).normalized(), Eigen::Vector3d(x, y, z));
 }
 
 std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options) {

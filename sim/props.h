@@ -35,6 +35,35 @@ enum class TableProps {
 };
 std::span<const std::pair<TableProps, const char*>> EnumNames(TableProps);
 
+// A static object of the user's on or around the table (config `scene.objects`): a mesh file placed
+// by table_T_object, e.g. the other objects of a real recording's view (docs/sensor.md, "At a
+// glance"). The pose is a translation [m] and a unit quaternion (x, y, z, w as in TUM files).
+struct SceneObject {
+  std::string name;  // unique, and none of the scene's own objects' names (BuildTableScene)
+  std::string mesh;  // an OBJ or PLY file, or a Duplo assembly (.json), as render.proxy
+  double scale = 1.0;  // applied to the file's vertex positions (0.001 for millimetres)
+  double x = 0.0, y = 0.0, z = 0.0;
+  double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;  // norm within 1e-3 of 1; normalised on use
+  SurfaceMaterial material{0.5, 0.0};
+
+  template <class V>
+  void VisitFields(V& v) {
+    v("name", name);
+    v("mesh", mesh);
+    v("scale", scale);
+    v("x", x);
+    v("y", y);
+    v("z", z);
+    v("qx", qx);
+    v("qy", qy);
+    v("qz", qz);
+    v("qw", qw);
+    v("material", material);
+  }
+  void Validate(const std::string& prefix) const;
+  Rigid3 TableTObject() const;
+};
+
 // The table's calibration (core/table_setup.h: play area, Like box, slider block) and the furniture
 // around it. The slider block's size is not a config key: the scene's block is a 2x2 Duplo brick
 // (kSliderBlockSize).
@@ -55,6 +84,8 @@ struct TableSceneOptions : TableSetup {
   TableProps props = TableProps::kNone;
   // Materials in the IR band (the structured-light sensor mode).
   SceneMaterials materials;
+  // The user's static objects (none by default); loaded by LoadSceneObjects.
+  std::vector<SceneObject> objects;
 
   template <class V>
   void VisitFields(V& v) {
@@ -74,6 +105,7 @@ struct TableSceneOptions : TableSetup {
     v("backdrop_y", backdrop_y);
     v("props", props);
     v("materials", materials);
+    v("objects", objects);
   }
   // Positive finite sizes; the play area, the Like box (with its tape) and the castle on the table;
   // the Like box apart from the play area and longer than the slider block; the wall behind the
@@ -91,6 +123,11 @@ inline constexpr Rgb8 kSkinColor = {226, 176, 144};
 // "play_area_tape", "like_box_tape", "backdrop" (if enabled), "castle" (if chosen). The slider
 // block and the hand move and are not included. Validates the options (prefix "scene").
 std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options);
+
+// The names BuildTableScene and the moving objects use; scene.objects may not take them.
+inline constexpr const char* kReservedObjectNames[] = {
+    "floor", "table", "play_area_tape", "like_box_tape", "backdrop", "castle", "proxy", "hand",
+    "slider"};
 
 // The slider block: a green 2x2 Duplo brick, model frame as BuildDuploMesh (footprint centred, z =
 // 0 at its bottom), 31.8 mm square.

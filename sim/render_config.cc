@@ -6,6 +6,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "core/error.h"
@@ -133,6 +134,13 @@ RenderConfig RenderConfig::FromConfig(const Config& config) {
   c.render = config.Get<RenderOptions>("render");
   c.camera = config.Get<CameraPlacement>("camera");
   c.scene = config.Get<TableSceneOptions>("scene");
+  // A config file names its objects' meshes relative to itself (a view file beside its models).
+  const std::filesystem::path folder = config.FolderOf("scene.objects");
+  for (SceneObject& o : c.scene.objects) {
+    if (!folder.empty() && std::filesystem::path(o.mesh).is_relative()) {
+      o.mesh = (folder / o.mesh).lexically_normal().string();
+    }
+  }
   c.hand = config.Get<HandOptions>("hand");
   c.sensor = config.Get<KinectSensorOptions>("sensor");
   c.motion = config.Get<DemoMotionOptions>("motion");

@@ -67,6 +67,17 @@ TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& pro
     const uint32_t object = scene_.AddStatic(part.name, part.mesh, Rigid3::Identity());
     scene_.SetMaterial(object, config.scene.materials.ForObject(part.name));
   }
+  for (size_t i = 0; i < config.scene.objects.size(); ++i) {
+    const SceneObject& o = config.scene.objects[i];
+    TriangleMesh mesh;
+    try {
+      mesh = LoadProxyModel(o.mesh, o.scale);
+    } catch (const InputError& e) {
+      throw InputError("scene.objects[" + std::to_string(i) + "].mesh (" + o.name + "): " + e.what());
+    }
+    const uint32_t object = scene_.AddStatic(o.name, mesh, o.TableTObject());
+    scene_.SetMaterial(object, o.material);
+  }
   proxy_ = scene_.AddMoving("proxy", proxy_model);
   const Bounds3 bounds = ComputeBounds(proxy_model);
   // The hand pinches the top of the proxy (below its studs for a Duplo figure) across its depth.

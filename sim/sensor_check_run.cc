@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iterator>
+#include <limits>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -190,6 +191,25 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
     report.native_view_depth_m[structured ? 2 : 1] = on_native_grid(depth_m, intrinsics);
   }
+  // Structured light over speckle patterns: the first is the row above.
+  report.pattern_near.push_back(report.like_for_like.back().structure);
+  if (!rendered_away.empty()) report.pattern_away.push_back(report.like_for_like_away.back().structure);
+  report.pattern_seeds.push_back(config.sensor.structured_light.pattern_seed);
+  for (int k = 1; k < view.patterns; ++k) {
+    KinectSensorOptions options = config.sensor;
+    options.mode = SensorMode::kStructuredLight;
+    options.structured_light.pattern_seed += k;
+    KinectSensor sensor(options, &scene.scene(), scene.table_T_camera());
+    const RgbdFrame frame = sensor.Render(0);
+    const std::vector<float> depth_m = DepthMetresFromUnits(frame.depth, frame.depth_scale);
+    report.pattern_seeds.push_back(options.structured_light.pattern_seed);
+    report.pattern_near.push_back(
+        AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx));
+    if (!rendered_away.empty()) {
+      report.pattern_away.push_back(AnalyseNeighbourhood(depth_m, width, height, mask,
+                                                         kNeighbourhoodRadiusPx, {}, rendered_away));
+    }
+  }
 }
 
 }  // namespace
@@ -267,19 +287,66 @@ std::string SensorCheckReport::FormatLikeForLike() const {
                 "\nlike for like: around the object (its mask grown by %d px), band widths in the "
                 "rendered sensor's pixels\n",
                 kNeighbourhoodRadiusPx);
-  std::string text = FormatNeighbourhoods(title, like_for_like);
+  std::string text = FormatNeighbourhoods(title, like_for_like, pattern_near);
   if (!like_for_like_away.empty()) {
     std::snprintf(title, sizeof(title),
                   "\nlike for like, away from the other objects (the real frame's other labels "
                   "grown by %d px, left out of both)\n",
                   kNeighbourhoodRadiusPx);
-    text += FormatNeighbourhoods(title, like_for_like_away);
+    text += FormatNeighbourhoods(title, like_for_like_away, pattern_away);
   }
   return text;
 }
 
-std::string SensorCheckReport::FormatNeighbourhoods(const std::string& title,
-                                                    const std::vector<NeighbourhoodRow>& rows) {
+namespace {
+
+// The statistics of the like-for-like tables, in the rendered sensor's pixels.
+struct NeighbourhoodStatistic {
+  const char* label;
+  const char* key;  // in sensor_check.json
+  double (*value)(const NeighbourhoodStructure&, double pixel_scale);
+};
+constexpr NeighbourhoodStatistic kNeighbourhoodStatistics[] = {
+    {"missing [%]", "missing_share",
+     [](const NeighbourhoodStructure& n, double) { return 100 * n.missing_share; }},
+    {"shadow band [px]", "shadow_band_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.shadow_band_px * s; }},
+    {"edge band [px]", "edge_band_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.edge_band_px * s; }},
+    {"shadow band across [px]", "shadow_band_across_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.shadow_band_across_px * s; }},
+    {"edge band across [px]", "edge_band_across_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.edge_band_across_px * s; }},
+};
+
+// Mean and sample standard deviation of one statistic's ratio to the real frame's over patterns.
+struct RatioSpread {
+  double mean = 0, sd = 0, min = 0, max = 0;
+};
+RatioSpread SpreadOfRatios(const NeighbourhoodStatistic& statistic,
+                           const std::vector<NeighbourhoodStructure>& patterns, double real) {
+  RatioSpread r;
+  r.min = std::numeric_limits<double>::infinity();
+  r.max = -r.min;
+  for (const NeighbourhoodStructure& n : patterns) {
+    const double ratio = statistic.value(n, 1.0) / real;
+    r.mean += ratio / patterns.size();
+    r.min = std::min(r.min, ratio);
+    r.max = std::max(r.max, ratio);
+  }
+  for (const NeighbourhoodStructure& n : patterns) {
+    const double d = statistic.value(n, 1.0) / real - r.mean;
+    r.sd += patterns.size() > 1 ? d * d / (patterns.size() - 1) : 0.0;
+  }
+  r.sd = std::sqrt(r.sd);
+  return r;
+}
+
+}  // namespace
+
+std::string SensorCheckReport::FormatNeighbourhoods(
+    const std::string& title, const std::vector<NeighbourhoodRow>& rows,
+    const std::vector<NeighbourhoodStructure>& patterns) {
   char line[200];
   std::string text = title;
   std::snprintf(line, sizeof(line), "%-24s", "");
@@ -288,28 +355,32 @@ std::string SensorCheckReport::FormatNeighbourhoods(const std::string& title,
     std::snprintf(line, sizeof(line), "%26s", row.name.c_str());
     text += line;
   }
-  text += "     SL/real   goal\n";
+  text += "     SL/real";
+  if (patterns.size() > 1) {
+    std::snprintf(line, sizeof(line), "  %2zu patterns: SL/real", patterns.size());
+    text += line;
+  }
+  text += "   goal\n";
   const NeighbourhoodRow& real = rows.front();
   const NeighbourhoodRow& sl = rows.back();
-  auto add = [&](const char* label, auto value) {
-    std::snprintf(line, sizeof(line), "%-24s", label);
+  for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+    std::snprintf(line, sizeof(line), "%-24s", statistic.label);
     text += line;
     for (const NeighbourhoodRow& row : rows) {
-      std::snprintf(line, sizeof(line), "%26.2f", value(row));
+      std::snprintf(line, sizeof(line), "%26.2f", statistic.value(row.structure, row.pixel_scale));
       text += line;
     }
-    std::snprintf(line, sizeof(line), "%12.2f   0.8-1.2\n", value(sl) / value(real));
+    const double real_value = statistic.value(real.structure, real.pixel_scale);
+    std::snprintf(line, sizeof(line), "%12.2f",
+                  statistic.value(sl.structure, sl.pixel_scale) / real_value);
     text += line;
-  };
-  add("missing [%]", [](const NeighbourhoodRow& r) { return 100 * r.structure.missing_share; });
-  add("shadow band [px]",
-      [](const NeighbourhoodRow& r) { return r.structure.shadow_band_px * r.pixel_scale; });
-  add("edge band [px]",
-      [](const NeighbourhoodRow& r) { return r.structure.edge_band_px * r.pixel_scale; });
-  add("shadow band across [px]",
-      [](const NeighbourhoodRow& r) { return r.structure.shadow_band_across_px * r.pixel_scale; });
-  add("edge band across [px]",
-      [](const NeighbourhoodRow& r) { return r.structure.edge_band_across_px * r.pixel_scale; });
+    if (patterns.size() > 1) {
+      const RatioSpread r = SpreadOfRatios(statistic, patterns, real_value);
+      std::snprintf(line, sizeof(line), "  %7.2f +- %.2f (%.2f-%.2f)", r.mean, r.sd, r.min, r.max);
+      text += line;
+    }
+    text += "   0.8-1.2\n";
+  }
   std::snprintf(line, sizeof(line), "%-24s", "runs (shadow, edge)");
   text += line;
   for (const NeighbourhoodRow& row : rows) {
@@ -358,12 +429,37 @@ nlohmann::json SensorCheckReport::ToJson() const {
     }
     return like;
   };
-  return {{"columns", j},
-          {"rendered_frames", frames},
-          {"error_structure", error_structure},
-          {"temporal_correlation", temporal_json},
-          {"like_for_like", neighbourhoods(like_for_like)},
-          {"like_for_like_away", neighbourhoods(like_for_like_away)}};
+  // Over speckle patterns: each pattern's statistics and each ratio's spread.
+  auto over_patterns = [&](const std::vector<NeighbourhoodRow>& rows,
+                           const std::vector<NeighbourhoodStructure>& patterns) {
+    nlohmann::json per_pattern = nlohmann::json::array();
+    for (size_t k = 0; k < patterns.size(); ++k) {
+      per_pattern.push_back(
+          neighbourhoods(std::vector<NeighbourhoodRow>{{"view, SL", 1.0, patterns[k]}})[0]);
+      per_pattern.back()["pattern_seed"] = pattern_seeds[k];
+    }
+    nlohmann::json ratios = nlohmann::json::object();
+    for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+      const NeighbourhoodRow& real = rows.front();
+      const RatioSpread r =
+          SpreadOfRatios(statistic, patterns, statistic.value(real.structure, real.pixel_scale));
+      ratios[statistic.key] = {{"mean", r.mean}, {"sd", r.sd}, {"min", r.min}, {"max", r.max}};
+    }
+    return nlohmann::json{{"patterns", per_pattern}, {"ratio_to_real", ratios}};
+  };
+  nlohmann::json result = {{"columns", j},
+                           {"rendered_frames", frames},
+                           {"error_structure", error_structure},
+                           {"temporal_correlation", temporal_json},
+                           {"like_for_like", neighbourhoods(like_for_like)},
+                           {"like_for_like_away", neighbourhoods(like_for_like_away)}};
+  if (!pattern_near.empty()) {
+    result["like_for_like_patterns"] = over_patterns(like_for_like, pattern_near);
+  }
+  if (!pattern_away.empty()) {
+    result["like_for_like_away_patterns"] = over_patterns(like_for_like_away, pattern_away);
+  }
+  return result;
 }
 
 void WriteSensorCheck(const SensorCheckReport& report, const std::filesystem::path& out) {

@@ -36,10 +36,15 @@ struct RealView {
   PinholeIntrinsics intrinsics;
   std::vector<float> depth_m;  // the real frame [m], width x height row-major, 0 = missing
   std::vector<uint8_t> mask;   // the object's pixels in it (its label image), non-zero = object
-  // The other labelled objects' pixels (non-zero), which the rendered view does not hold; empty:
-  // none known.
+  // The other labelled objects' pixels (non-zero); empty: none known. The view places those it
+  // knows as scene.objects (the mug and the foam brick beside the gelatin box).
   std::vector<uint8_t> others;
   RenderConfig config;
+  // Speckle patterns the structured-light view is rendered with: the config's pattern_seed and
+  // the next patterns - 1 seeds. The device has one fixed pattern, the model one random draw of
+  // it, and the like-for-like statistics hang on the draw (docs/sensor.md, "Over speckle
+  // patterns"): their mean and spread over draws are what to compare.
+  int patterns = 1;
 };
 
 // The neighbourhood of the object compared (AnalyseNeighbourhood): its mask grown by this many
@@ -86,6 +91,11 @@ struct SensorCheckReport {
   // `excluded`, mapped to the rendered frames by ResampleDepthNearest). Empty without
   // RealView::others.
   std::vector<NeighbourhoodRow> like_for_like_away;
+  // The structured-light view over RealView::patterns speckle patterns (the first is the one in
+  // like_for_like's last row): per pattern, the neighbourhood near the object and away from the
+  // other objects (the latter empty without RealView::others).
+  std::vector<uint64_t> pattern_seeds;
+  std::vector<NeighbourhoodStructure> pattern_near, pattern_away;
   // Their depth images for sensor_check_view.png (real, statistical, structured light), the
   // rendered ones resampled to the real frame's intrinsics (ResampleDepthNearest): the same scale
   // and field of view.
@@ -103,7 +113,8 @@ struct SensorCheckReport {
   std::string Format() const;
   std::string FormatLikeForLike() const;
   static std::string FormatNeighbourhoods(const std::string& title,
-                                          const std::vector<NeighbourhoodRow>& rows);
+                                          const std::vector<NeighbourhoodRow>& rows,
+                                          const std::vector<NeighbourhoodStructure>& patterns = {});
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };

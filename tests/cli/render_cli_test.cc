@@ -3,6 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 using test_util::ReadBytes;
 using test_util::RunMmh;
@@ -220,6 +224,41 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // The statistical sensor's holes are rules; the structured light's beside the object come from
   // the matching and so are more (measured 8.5 and 10.3 %, real 12.3 %).
   EXPECT_GT(like[2]["missing_share"].get<double>(), like[1]["missing_share"].get<double>());
+
+  // Over speckle patterns (--patterns, 8 by default): the config's pattern_seed and the next
+  // seven; the first pattern is the table's structured-light column, and the spread is of the
+  // per-pattern ratios to the real frame (recomputed here).
+  EXPECT_THAT(r.output, HasSubstr("8 patterns: SL/real"));
+  const nlohmann::json json = nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"));
+  for (const char* table : {"like_for_like", "like_for_like_away"}) {
+    const nlohmann::json& over = json[std::string(table) + "_patterns"];
+    ASSERT_EQ(over["patterns"].size(), 8u) << table;
+    const nlohmann::json& real = json[table][0];
+    for (const char* key : {"missing_share", "shadow_band_across_px", "edge_band_across_px"}) {
+      EXPECT_EQ(over["patterns"][0][key], json[table][2][key]) << table << " " << key;
+      double sum = 0, sum2 = 0, low = 1e9;
+      for (int k = 0; k < 8; ++k) {
+        EXPECT_EQ(over["patterns"][k]["pattern_seed"].get<uint64_t>(), 20100604u + k);
+        const double ratio = over["patterns"][k][key].get<double>() / real[key].get<double>();
+        sum += ratio;
+        sum2 += ratio * ratio;
+        low = std::min(low, ratio);
+      }
+      const nlohmann::json& spread = over["ratio_to_real"][key];
+      EXPECT_NEAR(spread["mean"].get<double>(), sum / 8, 1e-12) << table << " " << key;
+      EXPECT_NEAR(spread["sd"].get<double>(), std::sqrt((sum2 - sum * sum / 8) / 7), 1e-9);
+      EXPECT_EQ(spread["min"].get<double>(), low);
+      EXPECT_GT(spread["sd"].get<double>(), 0.0) << "the patterns differ";
+    }
+  }
+  // One pattern: no spread; a count out of range is a usage error that writes nothing.
+  const auto one = RunMmh("sensor-check --frames 1 --patterns 1");
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  EXPECT_THAT(one.output, Not(HasSubstr("patterns: SL/real")));
+  const auto zero = RunMmh("sensor-check --frames 1 --patterns 0 --out " + (dir_ / "zero").string());
+  EXPECT_EQ(zero.exit_code, 2) << zero.output;
+  EXPECT_THAT(zero.output, HasSubstr("--patterns"));
+  EXPECT_FALSE(fs::exists(dir_ / "zero"));
 }
 
 }  // namespace

@@ -374,6 +374,22 @@ TEST(Config, SourceOf) {
   EXPECT_EQ(config.SourceOf("montag").name, path.string());
 }
 
+TEST(Config, FolderOfIsTheFilesFolderUnlessASetGaveTheValue) {
+  TempDir dir;
+  EXPECT_EQ(Config().FolderOf("scene.objects"), fs::path());
+  const fs::path path = WriteText(dir / "c.json", R"({"scene": {"objects": []}, "montage": {}})");
+  Config config = Config::Load(path);
+  EXPECT_EQ(config.FolderOf("scene.objects"), dir.path());
+  config.Set("montage.lambda=1");
+  EXPECT_EQ(config.FolderOf("scene.objects"), dir.path());
+  config.Set("scene.objects=[]");
+  EXPECT_EQ(config.FolderOf("scene.objects"), fs::path());
+  EXPECT_EQ(config.FolderOf("scene"), fs::path());  // a --set below the key
+  Config above = Config::Load(path);
+  above.Set("scene={}");
+  EXPECT_EQ(above.FolderOf("scene.objects"), fs::path());
+}
+
 // ----------------------------------------------------------------------------------------------
 // RequireOnlySections
 

@@ -83,6 +83,17 @@ struct CountOptions {
   void Validate(const std::string&) const {}
 };
 
+// A list of nested structs (a JSON array of objects).
+struct ListOptions {
+  std::vector<BlendOptions> blends = {BlendOptions{3, Weight::kSmoothstep}};
+  int after = 1;
+  template <class V>
+  void VisitFields(V& v) {
+    v("blends", blends);
+    v("after", after);
+  }
+};
+
 const ConfigSource kSource{"configs/test.json"};
 
 template <class T>
@@ -313,6 +324,40 @@ TEST(Options, SizeTAndUint64FieldsAreRead) {
   // Negative values are still rejected.
   EXPECT_THAT(FromJsonError<CountOptions>(json{{"max_frames", -1}}),
               HasSubstr("'montage.max_frames'"));
+}
+
+TEST(Options, ListOfStructsRoundTripsAndReplacesTheDefaultList) {
+  ListOptions options;
+  EXPECT_EQ(ToJson(options),
+            json::parse(R"({"blends": [{"window": 3, "weight": "smoothstep"}], "after": 1})"));
+  FromJson(json::parse(R"({"blends": [{"window": 7}, {"weight": "smoothstep"}]})"), "", kSource,
+           &options);
+  ASSERT_EQ(options.blends.size(), 2u);
+  EXPECT_EQ(options.blends[0].window, 7);
+  EXPECT_EQ(options.blends[0].weight, Weight::kLinear);  // the element's default, not the list's
+  EXPECT_EQ(options.blends[1].window, 15);
+  EXPECT_EQ(options.blends[1].weight, Weight::kSmoothstep);
+  ListOptions back;
+  FromJson(ToJson(options), "", kSource, &back);
+  EXPECT_EQ(ToJson(back), ToJson(options));
+  FromJson(json::parse(R"({"blends": []})"), "", kSource, &back);
+  EXPECT_TRUE(back.blends.empty());
+  EXPECT_EQ(ToJson(back)["blends"], json::array());
+}
+
+TEST(Options, ListOfStructsErrorsNameTheElement) {
+  const std::string not_array = FromJsonError<ListOptions>(json::parse(R"({"blends": {"window": 3}})"));
+  EXPECT_THAT(not_array, HasSubstr("montage.blends"));
+  EXPECT_THAT(not_array, HasSubstr("an array of objects"));
+  const std::string unknown =
+      FromJsonError<ListOptions>(json::parse(R"({"blends": [{}, {"windw": 3}]})"));
+  EXPECT_THAT(unknown, HasSubstr("montage.blends[1].windw"));
+  EXPECT_THAT(unknown, HasSubstr("did you mean 'window'"));
+  const std::string wrong_type =
+      FromJsonError<ListOptions>(json::parse(R"({"blends": [{"window": "wide"}]})"));
+  EXPECT_THAT(wrong_type, HasSubstr("montage.blends[0].window"));
+  EXPECT_THAT(FromJsonError<ListOptions>(json::parse(R"({"blends": [3]})")),
+              HasSubstr("montage.blends[0]"));
 }
 
 TEST(Options, SuggestName) {

@@ -14,6 +14,11 @@ defaults but the proxy's, a matte printed box) and table_T_proxy.tum:
                    through the object's origin and slid 2 cm along the table's x, over --frames
                    frames (0.5 deg and 0.3 mm a frame at 60): more views of the same object, with
                    the speckle pattern moving over it.
+  --other TRACK MODEL NAME ALBEDO SPECULARITY (repeatable) places another object of the frame as a static scene
+                   object (scene.objects): its first pose from TRACK/groundtruth.tum (`mmh track`
+                   on the same recording with that object's label), carried into the table frame
+                   through the first track folder's table fit; MODEL is written relative to OUT;
+                   ALBEDO and SPECULARITY are its IR material.
 The camera is placed at the real camera's position in the table frame, looking at the point where
 the real optical axis meets the table; a look-at camera has no roll, so the real camera's roll
 about its axis (a few degrees) is not reproduced. Standard library only.
@@ -60,6 +65,9 @@ def main():
     parser.add_argument("--frames", type=int, default=60)
     parser.add_argument("--ir-albedo", type=float, default=0.6)
     parser.add_argument("--specularity", type=float, default=0.05)
+    parser.add_argument("--other", nargs=5, action="append", default=[],
+                        metavar=("TRACK", "MODEL", "NAME", "ALBEDO", "SPECULARITY"),
+                        help="another object of the frame, static (scene.objects)")
     parser.add_argument("--no-paths", dest="paths", action="store_false",
                         help="leave render.proxy and render.trajectory out of render.json (given "
                              "with --set instead: the committed views/ of the tests)")
@@ -75,15 +83,28 @@ def main():
     along = -t_tc[2] / forward[2]
     look_at = [t_tc[i] + along * forward[i] for i in range(3)]
 
-    poses = []
-    for line in open(os.path.join(args.track_folder, "groundtruth.tum")):
-        if line.startswith("#") or not line.strip():
-            continue
-        v = [float(a) for a in line.split()]
-        r_co = quaternion_to_matrix(*v[4:8])
-        poses.append((multiply(r_tc, r_co), apply(r_tc, t_tc, v[1:4])))
-    if not poses:
-        raise SystemExit(f"{args.track_folder}/groundtruth.tum: no poses")
+    def table_poses(track_folder):
+        poses = []
+        for line in open(os.path.join(track_folder, "groundtruth.tum")):
+            if line.startswith("#") or not line.strip():
+                continue
+            v = [float(a) for a in line.split()]
+            r_co = quaternion_to_matrix(*v[4:8])
+            poses.append((multiply(r_tc, r_co), apply(r_tc, t_tc, v[1:4])))
+        if not poses:
+            raise SystemExit(f"{track_folder}/groundtruth.tum: no poses")
+        return poses
+
+    poses = table_poses(args.track_folder)
+    objects = []
+    for track, model, name, albedo, specularity in args.other:
+        r, t = table_poses(track)[0]
+        q = matrix_to_quaternion(r)
+        objects.append({"name": name, "mesh": os.path.relpath(model, args.out),
+                        "x": t[0], "y": t[1], "z": t[2],
+                        "qx": q[0], "qy": q[1], "qz": q[2], "qw": q[3],
+                        "material": {"ir_albedo": float(albedo),
+                                     "specularity": float(specularity)}})
 
     os.makedirs(args.out, exist_ok=True)
     # render.json + table_T_proxy.tum, or (--no-paths, several views in one folder) NAME_MOTION.*
@@ -117,6 +138,8 @@ def main():
         "scene": {"materials": {"proxy": {"ir_albedo": args.ir_albedo,
                                           "specularity": args.specularity}}},
     }
+    if objects:
+        config["scene"]["objects"] = objects
     name = "render.json" if args.paths else stem + ".json"
     with open(os.path.join(args.out, name), "w") as out:
         json.dump(config, out, indent=2)
