@@ -183,7 +183,8 @@ struct KinectSensor::Impl {
    private:
     void WriteMaterial(const HitPacket& packet, int i, size_t p) {
       const uint32_t object = packet.object[i];
-      ir_diffuse_[p] = s_.object_ir_diffuse[object];
+      const std::vector<float>& faces = s_.face_ir_diffuse[object];
+      ir_diffuse_[p] = faces.empty() ? s_.object_ir_diffuse[object] : faces[packet.face[i]];
       ir_specular_[p] = s_.object_ir_specular[object];
     }
 
@@ -255,6 +256,9 @@ struct KinectSensor::Impl {
   SensorTimings timings;
   std::vector<const uint8_t*> face_colors;  // per object
   std::vector<float> object_ir_diffuse, object_ir_specular;  // per object (SurfaceMaterial)
+  // Per object, per face: the diffuse IR reflectance of a printed surface (colour_contrast > 0);
+  // empty: object_ir_diffuse for every face.
+  std::vector<std::vector<float>> face_ir_diffuse;
   std::unique_ptr<internal::SpeckleMatcher> speckle;  // structured-light mode
   std::vector<uint16_t> ir_image;                      // structured-light mode, depth view
   std::vector<MissingCause> last_causes;     // when requested (KeepMissingCauses)
@@ -777,6 +781,19 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
     s.object_ir_diffuse.push_back(
         static_cast<float>(material.ir_albedo * (1.0 - material.specularity)));
     s.object_ir_specular.push_back(static_cast<float>(material.specularity));
+    s.face_ir_diffuse.emplace_back();
+    if (material.colour_contrast > 0) {
+      const TriangleMesh& mesh = scene->object_mesh(o);
+      std::vector<float>& faces = s.face_ir_diffuse.back();
+      faces.resize(mesh.face_count());
+      for (int f = 0; f < mesh.face_count(); ++f) {
+        const int brightest = std::max({mesh.face_colors(f, 0), mesh.face_colors(f, 1),
+                                        mesh.face_colors(f, 2)});
+        faces[f] = static_cast<float>(
+            s.object_ir_diffuse.back() *
+            ((1.0 - material.colour_contrast) + material.colour_contrast * brightest / 255.0));
+      }
+    }
     s.moving.push_back(scene->is_moving(o));
     s.moving_clusters.push_back(s.moving.back() ? ClusterBounds(scene->object_mesh(o), 3)
                                                 : std::vector<Bounds3>());

@@ -7,6 +7,7 @@ namespace mmh::sim {
 void SurfaceMaterial::Validate(const std::string& prefix) const {
   RequireProbability(ir_albedo, prefix + ".ir_albedo");
   RequireProbability(specularity, prefix + ".specularity");
+  RequireProbability(colour_contrast, prefix + ".colour_contrast");
 }
 
 void SceneMaterials::Validate(const std::string& prefix) const {

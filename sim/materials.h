@@ -13,11 +13,17 @@ namespace mmh::sim {
 struct SurfaceMaterial {
   double ir_albedo = 0.5;    // diffuse reflectance in [0, 1]
   double specularity = 0.0;  // share of the reflection that is mirror-like, in [0, 1]
+  // Printed surfaces: the share c in [0, 1] of the diffuse reflectance that follows each face's
+  // colour, ir_albedo ((1 - c) + c max(R, G, B) / 255). Black print (carbon) absorbs at 830 nm,
+  // while the dyes of coloured inks are largely transparent there, so a bright colour of any hue
+  // stays bright: the brightest channel, not the luminance. 0: one albedo for the whole object.
+  double colour_contrast = 0.0;
 
   template <class V>
   void VisitFields(V& v) {
     v("ir_albedo", ir_albedo);
     v("specularity", specularity);
+    v("colour_contrast", colour_contrast);
   }
   void Validate(const std::string& prefix) const;
 };

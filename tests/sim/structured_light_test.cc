@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -113,6 +115,48 @@ TEST(StructuredLight, DarkFarAndMirrorSurfacesLoseThePattern) {
   // A mirror facing the camera at 1 m saturates the IR image where it returns the projector.
   EXPECT_GT(CentreStats(RenderWall(1.0, SurfaceMaterial{0.5, 1.0}, options), 1.0).missing,
             0.5 * 400 * 300);
+}
+
+// Missing share of the centre window's left and right halves (columns 120-319, 320-519).
+std::pair<double, double> MissingByHalf(const RgbdFrame& frame) {
+  int missing[2] = {0, 0};
+  const int w = frame.depth_intrinsics.width;
+  for (int v = 90; v < 390; ++v) {
+    for (int u = 120; u < 520; ++u) missing[u >= 320] += frame.depth[v * w + u] == 0;
+  }
+  return {missing[0] / (200.0 * 300), missing[1] / (200.0 * 300)};
+}
+
+TEST(StructuredLight, PrintedFacesFollowTheirColour) {
+  // One wall at 1.5 m, printed black on one half and white on the other (one object, so the
+  // albedo is per face).
+  TriangleMesh wall, black = Quad(10, 20), white = Quad(10, 20);
+  black.face_colors.setConstant(0);
+  white.face_colors.setConstant(255);
+  AppendMesh(black, Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-5, 0, 0)), &wall);
+  AppendMesh(white, Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(5, 0, 0)), &wall);
+  auto render = [&](double contrast) {
+    RayScene scene;
+    const uint32_t object = scene.AddStatic("wall", wall, WallAt(1.5));
+    scene.SetMaterial(object, SurfaceMaterial{0.5, 0.0, contrast});
+    scene.Commit();
+    KinectSensor sensor(StructuredLight(), &scene, Rigid3::Identity());
+    return MissingByHalf(sensor.Render(0, RenderMode::kFull));
+  };
+  // Without contrast both halves are the same grey wall and match.
+  const auto [plain_left, plain_right] = render(0.0);
+  EXPECT_LT(plain_left, 0.05);
+  EXPECT_LT(plain_right, 0.05);
+  // Fully printed: the black half returns no pattern, the white one the whole albedo.
+  const auto [left, right] = render(1.0);
+  EXPECT_GT(std::max(left, right), 0.9) << left << " " << right;
+  EXPECT_LT(std::min(left, right), 0.05) << left << " " << right;
+  try {
+    SurfaceMaterial{0.5, 0.0, 1.5}.Validate("scene.objects[0].material");
+    FAIL() << "accepted a contrast of 1.5";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("scene.objects[0].material.colour_contrast"));
+  }
 }
 
 TEST(StructuredLight, ErrorsAreSpatiallyCorrelatedUnlikeTheStatisticalModel) {
