@@ -65,6 +65,8 @@ struct SensorCheckArgs {
   std::string view, view_model, view_trajectory, view_label;
   int view_object = 8;
   int patterns = 8;
+  int view_frames = 10;
+  bool view_frames_given = false;  // else as many as the --sequence has, up to view_frames
   int frames = 3;
 };
 
@@ -91,7 +93,8 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
       trajectory = std::filesystem::path(args.view).replace_extension(".tum").string();
     }
     view = pipeline::ReadRealView(args.sequence, args.view_label, args.view_object, args.view,
-                                  args.view_model, trajectory, render.sensor);
+                                  args.view_model, trajectory, render.sensor,
+                                  args.view_frames_given ? args.view_frames : -args.view_frames);
     view->patterns = args.patterns;
   }
   const sim::SensorCheckReport report =
@@ -156,6 +159,13 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
                   "Label image of the sequence's first frame (8-bit, YCB-Video -label.png)")
       ->capture_default_str();
   cmd->add_option("--view-object", args->view_object, "The object's value in the label image")
+      ->capture_default_str();
+  cmd->add_option("--view-frames", args->view_frames,
+                  "Real frames of the view compared (the first and the next ones, their labels "
+                  "named as --view-label's with the frame number counted up): the real side's "
+                  "spread; by default as many as the --sequence has, up to 10")
+      ->check(CLI::Range(1, 1000))
+      ->each([args](const std::string&) { args->view_frames_given = true; })
       ->capture_default_str();
   cmd->add_option("--patterns", args->patterns,
                   "Speckle patterns the view is rendered with in structured light (the config's "

@@ -1,5 +1,7 @@
 #include "pipeline/depth_sequence.h"
 
+#include <algorithm>
+#include <cctype>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -18,7 +20,7 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
                   folder.filename().string();
   if (source.size() < frames) {
     ThrowBadValue(folder.string() + ": frames", std::to_string(source.size()),
-                  "at least " + std::to_string(frames) + " frames (sensor-check's temporal lags)");
+                  "at least " + std::to_string(frames) + " frames");
   }
   RgbdFrame frame;
   for (int k = 0; k < frames && source.Next(&frame); ++k) {
@@ -43,36 +45,73 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
   return sequence;
 }
 
+namespace {
+
+// The label image of the frame `later` frames after `first_label`'s: the leading number of its
+// name counted up, zero-padded to the same width (YCB-Video: 000001-label.png, 000002-...).
+std::filesystem::path LaterLabel(const std::filesystem::path& first_label, int later) {
+  const std::string name = first_label.filename().string();
+  size_t digits = 0;
+  while (digits < name.size() && std::isdigit(static_cast<unsigned char>(name[digits]))) ++digits;
+  if (digits == 0 || digits > 9) {
+    ThrowBadValue(first_label.string() + ": name", "\"" + name + "\"",
+                  "a name starting with its frame's number (YCB-Video's 000001-label.png), to "
+                  "find the later frames' labels");
+  }
+  std::string number = std::to_string(std::stol(name.substr(0, digits)) + later);
+  if (number.size() < digits) number.insert(0, digits - number.size(), '0');
+  return first_label.parent_path() / (number + name.substr(digits));
+}
+
+// The object's pixels (`mask`) and the other labelled objects' (`others`) in an 8-bit label
+// image of the depth frame's size.
+void ReadLabels(const std::filesystem::path& label, int object, int width, int height,
+                std::vector<uint8_t>* mask, std::vector<uint8_t>* others) {
+  const RgbImage labels = ReadRgbImage(label);
+  if (labels.width != width || labels.height != height) {
+    ThrowBadValue(label.string() + ": size",
+                  std::to_string(labels.width) + "x" + std::to_string(labels.height),
+                  "the depth frame's " + std::to_string(width) + "x" + std::to_string(height));
+  }
+  const size_t n = static_cast<size_t>(width) * height;
+  mask->assign(n, 0);
+  others->assign(n, 0);
+  size_t pixels = 0;
+  for (size_t p = 0; p < n; ++p) {
+    (*mask)[p] = labels.rgb[3 * p] == object;
+    (*others)[p] = labels.rgb[3 * p] != 0 && labels.rgb[3 * p] != object;
+    pixels += (*mask)[p];
+  }
+  if (pixels == 0) {
+    ThrowBadValue(label.string() + ": object", std::to_string(object), "a label the image holds");
+  }
+}
+
+}  // namespace
+
 sim::RealView ReadRealView(const std::filesystem::path& folder, const std::filesystem::path& label,
                            int object, const std::filesystem::path& view,
                            const std::filesystem::path& model,
                            const std::filesystem::path& trajectory,
-                           const sim::KinectSensorOptions& sensor) {
-  sim::DepthSequence first = ReadDepthSequence(folder, 1);
+                           const sim::KinectSensorOptions& sensor, int frames) {
+  if (frames < 1) {
+    frames = std::min(-frames, track::RecordingFrameSource(folder).size());
+    if (frames < 1) ThrowBadValue(folder.string() + ": frames", "0", "at least 1 frame");
+  }
+  sim::DepthSequence sequence = ReadDepthSequence(folder, frames);
   sim::RealView real;
-  real.name = first.name + " frame 1";
-  real.width = first.width;
-  real.height = first.height;
-  real.intrinsics = first.intrinsics;
-  real.depth_m = std::move(first.depth_m.front());
-  const RgbImage labels = ReadRgbImage(label);
-  if (labels.width != real.width || labels.height != real.height) {
-    ThrowBadValue(label.string() + ": size",
-                  std::to_string(labels.width) + "x" + std::to_string(labels.height),
-                  "the depth frame's " + std::to_string(real.width) + "x" +
-                      std::to_string(real.height));
-  }
-  real.mask.assign(real.depth_m.size(), 0);
-  real.others.assign(real.depth_m.size(), 0);
-  size_t pixels = 0;
-  for (size_t p = 0; p < real.mask.size(); ++p) {
-    real.mask[p] = labels.rgb[3 * p] == object;
-    real.others[p] = labels.rgb[3 * p] != 0 && labels.rgb[3 * p] != object;
-    pixels += real.mask[p];
-  }
-  if (pixels == 0) {
-    ThrowBadValue(label.string() + ": object", std::to_string(object),
-                  "a label the image holds");
+  real.name = sequence.name + " frame 1";
+  real.width = sequence.width;
+  real.height = sequence.height;
+  real.intrinsics = sequence.intrinsics;
+  real.depth_m = std::move(sequence.depth_m.front());
+  ReadLabels(label, object, real.width, real.height, &real.mask, &real.others);
+  for (int k = 1; k < frames; ++k) {
+    sim::RealView::Frame frame;
+    frame.depth_m = std::move(sequence.depth_m[k]);
+    ReadLabels(LaterLabel(label, k), object, real.width, real.height, &frame.mask,
+               &frame.others);
+    real.later_frames.push_back(std::move(frame));
   }
   Config config = Config::Load(view);
   if (config.root().contains("sensor")) {

@@ -20,12 +20,16 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
 // output without paths) with `model` as the proxy and `trajectory` as its poses, rendered by
 // `sensor` (the sensor under test: the view file places things, it does not choose the sensor).
 // The view's scene.objects name their mesh files relative to the view file (as any config file).
+// `frames` > 1: the recording's next frames too (RealView::later_frames; frames <= -1: as many as
+// the recording has, at most -frames), their labels named as
+// `label` with its leading frame number counted up (YCB-Video's 000001-label.png, 000002-...);
+// InputError naming the label file when its name has no leading number.
 // InputError naming the file when the label image differs in size or holds no pixel of the
 // object, or when the view file has a sensor section.
 sim::RealView ReadRealView(const std::filesystem::path& folder, const std::filesystem::path& label,
                            int object, const std::filesystem::path& view,
                            const std::filesystem::path& model,
                            const std::filesystem::path& trajectory,
-                           const sim::KinectSensorOptions& sensor);
+                           const sim::KinectSensorOptions& sensor, int frames = 1);
 
 }  // namespace mmh::pipeline

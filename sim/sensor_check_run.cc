@@ -128,6 +128,16 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   report.like_for_like.push_back(
       {view.name, real_scale,
        AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius)});
+  report.real_near.push_back(report.like_for_like.back().structure);
+  for (const RealView::Frame& frame : view.later_frames) {
+    if (frame.depth_m.size() != view.depth_m.size() || frame.mask.size() != view.mask.size() ||
+        frame.others.size() != view.others.size()) {
+      ThrowBadValue(view.name + ": later frame", std::to_string(frame.depth_m.size()) + " pixels",
+                    "the first frame's size, with its mask and other objects' mask");
+    }
+    report.real_near.push_back(
+        AnalyseNeighbourhood(frame.depth_m, view.width, view.height, frame.mask, real_radius));
+  }
   // Near the other objects (grown as the neighbourhood is), on the real grid and on the rendered
   // one (the same rays).
   std::vector<uint8_t> real_away, rendered_away;
@@ -145,6 +155,12 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
         {view.name, real_scale,
          AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius, {},
                               real_away)});
+    report.real_away.push_back(report.like_for_like_away.back().structure);
+    for (const RealView::Frame& frame : view.later_frames) {
+      report.real_away.push_back(AnalyseNeighbourhood(
+          frame.depth_m, view.width, view.height, frame.mask, real_radius, {},
+          GrowMask(frame.others, view.width, view.height, real_radius)));
+    }
   }
   report.view_depth_m[0] = view.depth_m;
   report.view_width = view.width;
@@ -287,13 +303,13 @@ std::string SensorCheckReport::FormatLikeForLike() const {
                 "\nlike for like: around the object (its mask grown by %d px), band widths in the "
                 "rendered sensor's pixels\n",
                 kNeighbourhoodRadiusPx);
-  std::string text = FormatNeighbourhoods(title, like_for_like, pattern_near);
+  std::string text = FormatNeighbourhoods(title, like_for_like, pattern_near, real_near);
   if (!like_for_like_away.empty()) {
     std::snprintf(title, sizeof(title),
                   "\nlike for like, away from the other objects (the real frame's other labels "
                   "grown by %d px, left out of both)\n",
                   kNeighbourhoodRadiusPx);
-    text += FormatNeighbourhoods(title, like_for_like_away, pattern_away);
+    text += FormatNeighbourhoods(title, like_for_like_away, pattern_away, real_away);
   }
   return text;
 }
@@ -342,11 +358,29 @@ RatioSpread SpreadOfRatios(const NeighbourhoodStatistic& statistic,
   return r;
 }
 
+// Mean, minimum and maximum of one statistic over frames or patterns, in the rendered sensor's
+// pixels.
+struct Spread {
+  double mean = 0, min = 0, max = 0;
+};
+Spread SpreadOf(const NeighbourhoodStatistic& statistic,
+                const std::vector<NeighbourhoodStructure>& rows, double pixel_scale) {
+  Spread s{0, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  for (const NeighbourhoodStructure& n : rows) {
+    const double value = statistic.value(n, pixel_scale);
+    s.mean += value / rows.size();
+    s.min = std::min(s.min, value);
+    s.max = std::max(s.max, value);
+  }
+  return s;
+}
+
 }  // namespace
 
 std::string SensorCheckReport::FormatNeighbourhoods(
     const std::string& title, const std::vector<NeighbourhoodRow>& rows,
-    const std::vector<NeighbourhoodStructure>& patterns) {
+    const std::vector<NeighbourhoodStructure>& patterns,
+    const std::vector<NeighbourhoodStructure>& real_frames) {
   char line[200];
   std::string text = title;
   std::snprintf(line, sizeof(line), "%-24s", "");
@@ -390,7 +424,23 @@ std::string SensorCheckReport::FormatNeighbourhoods(
                       .c_str());
     text += line;
   }
-  return text + "\n";
+  text += "\n";
+  if (real_frames.size() > 1 && !patterns.empty()) {
+    std::snprintf(line, sizeof(line),
+                  "  over real frames 1-%zu and %zu pattern%s: real mean (min-max), SL mean "
+                  "(min-max), SL/real of the means\n",
+                  real_frames.size(), patterns.size(), patterns.size() > 1 ? "s" : "");
+    text += line;
+    for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+      const Spread r = SpreadOf(statistic, real_frames, real.pixel_scale);
+      const Spread sl = SpreadOf(statistic, patterns, 1.0);
+      std::snprintf(line, sizeof(line), "  %-24s %8.2f (%.2f-%.2f) %8.2f (%.2f-%.2f) %8.2f\n",
+                    statistic.label, r.mean, r.min, r.max, sl.mean, sl.min, sl.max,
+                    sl.mean / r.mean);
+      text += line;
+    }
+  }
+  return text;
 }
 
 nlohmann::json SensorCheckReport::ToJson() const {
@@ -447,6 +497,24 @@ nlohmann::json SensorCheckReport::ToJson() const {
     }
     return nlohmann::json{{"patterns", per_pattern}, {"ratio_to_real", ratios}};
   };
+  // The real frames, and the ratio of the mean over patterns to the mean over real frames.
+  auto over_real_frames = [&](const std::vector<NeighbourhoodRow>& rows,
+                              const std::vector<NeighbourhoodStructure>& real_frames,
+                              const std::vector<NeighbourhoodStructure>& patterns) {
+    const NeighbourhoodRow& real = rows.front();
+    nlohmann::json per_frame = nlohmann::json::array();
+    for (size_t k = 0; k < real_frames.size(); ++k) {
+      per_frame.push_back(neighbourhoods(std::vector<NeighbourhoodRow>{
+          {real.name.substr(0, real.name.rfind(" frame ")) + " frame " + std::to_string(k + 1),
+           real.pixel_scale, real_frames[k]}})[0]);
+    }
+    nlohmann::json ratios = nlohmann::json::object();
+    for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+      ratios[statistic.key] = SpreadOf(statistic, patterns, 1.0).mean /
+                              SpreadOf(statistic, real_frames, real.pixel_scale).mean;
+    }
+    return nlohmann::json{{"frames", per_frame}, {"ratio_of_means", ratios}};
+  };
   nlohmann::json result = {{"columns", j},
                            {"rendered_frames", frames},
                            {"error_structure", error_structure},
@@ -458,6 +526,13 @@ nlohmann::json SensorCheckReport::ToJson() const {
   }
   if (!pattern_away.empty()) {
     result["like_for_like_away_patterns"] = over_patterns(like_for_like_away, pattern_away);
+  }
+  if (real_near.size() > 1 && !pattern_near.empty()) {
+    result["like_for_like_real_frames"] = over_real_frames(like_for_like, real_near, pattern_near);
+  }
+  if (real_away.size() > 1 && !pattern_away.empty()) {
+    result["like_for_like_away_real_frames"] =
+        over_real_frames(like_for_like_away, real_away, pattern_away);
   }
   return result;
 }

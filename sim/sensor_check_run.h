@@ -45,6 +45,14 @@ struct RealView {
   // it, and the like-for-like statistics hang on the draw (docs/sensor.md, "Over speckle
   // patterns"): their mean and spread over draws are what to compare.
   int patterns = 1;
+  // The recording's frames 2, 3, ... of the same view (ReadRealView's `frames`), for the real
+  // side's spread: the real device's errors change from frame to frame (the camera moves by a
+  // few millimetres), the rendered view is compared at the first frame's poses.
+  struct Frame {
+    std::vector<float> depth_m;
+    std::vector<uint8_t> mask, others;
+  };
+  std::vector<Frame> later_frames;
 };
 
 // The neighbourhood of the object compared (AnalyseNeighbourhood): its mask grown by this many
@@ -96,6 +104,10 @@ struct SensorCheckReport {
   // other objects (the latter empty without RealView::others).
   std::vector<uint64_t> pattern_seeds;
   std::vector<NeighbourhoodStructure> pattern_near, pattern_away;
+  // The real frames (the first is like_for_like's first row), near the object and away from the
+  // other objects, in the real frame's pixels (like_for_like's first pixel_scale turns them into
+  // the rendered sensor's).
+  std::vector<NeighbourhoodStructure> real_near, real_away;
   // Their depth images for sensor_check_view.png (real, statistical, structured light), the
   // rendered ones resampled to the real frame's intrinsics (ResampleDepthNearest): the same scale
   // and field of view.
@@ -114,7 +126,8 @@ struct SensorCheckReport {
   std::string FormatLikeForLike() const;
   static std::string FormatNeighbourhoods(const std::string& title,
                                           const std::vector<NeighbourhoodRow>& rows,
-                                          const std::vector<NeighbourhoodStructure>& patterns = {});
+                                          const std::vector<NeighbourhoodStructure>& patterns = {},
+                                          const std::vector<NeighbourhoodStructure>& real_frames = {});
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };

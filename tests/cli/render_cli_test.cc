@@ -251,6 +251,37 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
       EXPECT_GT(spread["sd"].get<double>(), 0.0) << "the patterns differ";
     }
   }
+  // Over the real recording's frames 1-10 (by default as many as it has, up to 10): each frame's
+  // statistics, and the ratio of the patterns' mean to the frames' mean (recomputed here).
+  EXPECT_THAT(r.output, HasSubstr("over real frames 1-10 and 8 patterns"));
+  for (const char* table : {"like_for_like", "like_for_like_away"}) {
+    const nlohmann::json& frames = json[std::string(table) + "_real_frames"];
+    ASSERT_EQ(frames["frames"].size(), 10u) << table;
+    EXPECT_EQ(frames["frames"][0]["missing_share"], json[table][0]["missing_share"]);
+    EXPECT_THAT(frames["frames"][9]["frame"].get<std::string>(), HasSubstr("frame 10"));
+    double real = 0, rendered = 0;
+    for (int k = 0; k < 10; ++k) real += frames["frames"][k]["missing_share"].get<double>() / 10;
+    for (int k = 0; k < 8; ++k) {
+      rendered += json[std::string(table) + "_patterns"]["patterns"][k]["missing_share"]
+                      .get<double>() / 8;
+    }
+    EXPECT_NEAR(frames["ratio_of_means"]["missing_share"].get<double>(), rendered / real, 1e-12);
+    // The real frames differ (the camera moves by millimetres), so the spread is not zero.
+    EXPECT_NE(frames["frames"][0]["missing_share"], frames["frames"][5]["missing_share"]);
+  }
+  // Later frames' labels are found by the first one's leading frame number: a label named
+  // otherwise is an input error naming it, as is a recording with too few frames.
+  const fs::path odd = dir_ / "label.png";
+  fs::copy_file(fs::path(MMH_SOURCE_DIR) / "tests/data/real/ycbv/data/0000/000001-label.png", odd);
+  const auto unnamed = RunMmh("sensor-check --frames 1 --view-frames 2 --view-label " +
+                              odd.string() + " --out " + (dir_ / "unnamed").string());
+  EXPECT_EQ(unnamed.exit_code, 2) << unnamed.output;
+  EXPECT_THAT(unnamed.output, HasSubstr("label.png: name"));
+  EXPECT_FALSE(fs::exists(dir_ / "unnamed"));
+  const auto many = RunMmh("sensor-check --frames 1 --view-frames 11");
+  EXPECT_EQ(many.exit_code, 2) << many.output;
+  EXPECT_THAT(many.output, HasSubstr("at least 11 frames"));
+
   // One pattern: no spread; a count out of range is a usage error that writes nothing.
   const auto one = RunMmh("sensor-check --frames 1 --patterns 1");
   ASSERT_EQ(one.exit_code, 0) << one.output;
