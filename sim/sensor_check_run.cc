@@ -335,44 +335,39 @@ constexpr NeighbourhoodStatistic kNeighbourhoodStatistics[] = {
      [](const NeighbourhoodStructure& n, double s) { return n.edge_band_across_px * s; }},
 };
 
-// Mean and sample standard deviation of one statistic's ratio to the real frame's over patterns.
-struct RatioSpread {
+// Mean, sample standard deviation, minimum and maximum of values over patterns or frames. A band's
+// width is NaN where a frame has no run of that kind: such values are left out (all left out:
+// NaN).
+struct ValueSpread {
   double mean = 0, sd = 0, min = 0, max = 0;
 };
-RatioSpread SpreadOfRatios(const NeighbourhoodStatistic& statistic,
-                           const std::vector<NeighbourhoodStructure>& patterns, double real) {
-  RatioSpread r;
-  r.min = std::numeric_limits<double>::infinity();
-  r.max = -r.min;
-  for (const NeighbourhoodStructure& n : patterns) {
-    const double ratio = statistic.value(n, 1.0) / real;
-    r.mean += ratio / patterns.size();
-    r.min = std::min(r.min, ratio);
-    r.max = std::max(r.max, ratio);
+ValueSpread SpreadOfValues(const std::vector<double>& all) {
+  std::vector<double> values;
+  for (const double value : all) {
+    if (std::isfinite(value)) values.push_back(value);
   }
-  for (const NeighbourhoodStructure& n : patterns) {
-    const double d = statistic.value(n, 1.0) / real - r.mean;
-    r.sd += patterns.size() > 1 ? d * d / (patterns.size() - 1) : 0.0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (values.empty()) return {nan, nan, nan, nan};
+  ValueSpread r{0, 0, *std::min_element(values.begin(), values.end()),
+                *std::max_element(values.begin(), values.end())};
+  for (const double value : values) r.mean += value / values.size();
+  for (const double value : values) {
+    r.sd += values.size() > 1 ? (value - r.mean) * (value - r.mean) / (values.size() - 1) : 0.0;
   }
   r.sd = std::sqrt(r.sd);
   return r;
 }
 
-// Mean, minimum and maximum of one statistic over frames or patterns, in the rendered sensor's
-// pixels.
-struct Spread {
-  double mean = 0, min = 0, max = 0;
-};
-Spread SpreadOf(const NeighbourhoodStatistic& statistic,
-                const std::vector<NeighbourhoodStructure>& rows, double pixel_scale) {
-  Spread s{0, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+// One statistic over patterns or frames, in the rendered sensor's pixels, each divided by
+// `divisor` (the real frame's value for ratios, 1 for values).
+ValueSpread SpreadOf(const NeighbourhoodStatistic& statistic,
+                     const std::vector<NeighbourhoodStructure>& rows, double pixel_scale,
+                     double divisor = 1.0) {
+  std::vector<double> values;
   for (const NeighbourhoodStructure& n : rows) {
-    const double value = statistic.value(n, pixel_scale);
-    s.mean += value / rows.size();
-    s.min = std::min(s.min, value);
-    s.max = std::max(s.max, value);
+    values.push_back(statistic.value(n, pixel_scale) / divisor);
   }
-  return s;
+  return SpreadOfValues(values);
 }
 
 }  // namespace
@@ -409,7 +404,7 @@ std::string SensorCheckReport::FormatNeighbourhoods(
                   statistic.value(sl.structure, sl.pixel_scale) / real_value);
     text += line;
     if (patterns.size() > 1) {
-      const RatioSpread r = SpreadOfRatios(statistic, patterns, real_value);
+      const ValueSpread r = SpreadOf(statistic, patterns, 1.0, real_value);
       std::snprintf(line, sizeof(line), "  %7.2f +- %.2f (%.2f-%.2f)", r.mean, r.sd, r.min, r.max);
       text += line;
     }
@@ -432,8 +427,8 @@ std::string SensorCheckReport::FormatNeighbourhoods(
                   real_frames.size(), patterns.size(), patterns.size() > 1 ? "s" : "");
     text += line;
     for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
-      const Spread r = SpreadOf(statistic, real_frames, real.pixel_scale);
-      const Spread sl = SpreadOf(statistic, patterns, 1.0);
+      const ValueSpread r = SpreadOf(statistic, real_frames, real.pixel_scale);
+      const ValueSpread sl = SpreadOf(statistic, patterns, 1.0);
       std::snprintf(line, sizeof(line), "  %-24s %8.2f (%.2f-%.2f) %8.2f (%.2f-%.2f) %8.2f\n",
                     statistic.label, r.mean, r.min, r.max, sl.mean, sl.min, sl.max,
                     sl.mean / r.mean);
@@ -491,8 +486,8 @@ nlohmann::json SensorCheckReport::ToJson() const {
     nlohmann::json ratios = nlohmann::json::object();
     for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
       const NeighbourhoodRow& real = rows.front();
-      const RatioSpread r =
-          SpreadOfRatios(statistic, patterns, statistic.value(real.structure, real.pixel_scale));
+      const ValueSpread r =
+          SpreadOf(statistic, patterns, 1.0, statistic.value(real.structure, real.pixel_scale));
       ratios[statistic.key] = {{"mean", r.mean}, {"sd", r.sd}, {"min", r.min}, {"max", r.max}};
     }
     return nlohmann::json{{"patterns", per_pattern}, {"ratio_to_real", ratios}};

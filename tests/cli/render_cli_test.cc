@@ -282,6 +282,20 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   EXPECT_EQ(many.exit_code, 2) << many.output;
   EXPECT_THAT(many.output, HasSubstr("at least 11 frames"));
 
+  // The second committed view: the foam brick with the box and the mug beside it.
+  const fs::path ycbv = fs::path(MMH_SOURCE_DIR) / "tests/data/real/ycbv";
+  const auto brick = RunMmh(
+      "sensor-check --frames 1 --patterns 2 --view-frames 2 --view-object 21 --view " +
+      (ycbv / "views/061_foam_brick_static.json").string() + " --view-model " +
+      (ycbv / "models_real/061_foam_brick.obj").string() + " --out " + (dir_ / "brick").string());
+  ASSERT_EQ(brick.exit_code, 0) << brick.output;
+  const nlohmann::json brick_json =
+      nlohmann::json::parse(ReadBytes(dir_ / "brick" / "sensor_check.json"));
+  for (const auto& row : brick_json["like_for_like"]) {
+    EXPECT_GT(row["pixels"].get<double>(), 1000) << row.dump();
+  }
+  EXPECT_EQ(brick_json["like_for_like_real_frames"]["frames"].size(), 2u);
+
   // One pattern: no spread; a count out of range is a usage error that writes nothing.
   const auto one = RunMmh("sensor-check --frames 1 --patterns 1");
   ASSERT_EQ(one.exit_code, 0) << one.output;
