@@ -207,6 +207,35 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
     report.native_view_depth_m[structured ? 2 : 1] = on_native_grid(depth_m, intrinsics);
   }
+  // Errors over time in the view, structured light: frames 0 .. the last lag from a still camera
+  // (only the IR noise changes), and with the real camera's motion (the trajectory's object poses
+  // are the real camera_T_object carried into the table frame through the first frame's table
+  // fit, so a still object seen by camera_k = table_T_object_0 table_T_object_k^-1 table_T_camera
+  // has the real frame k's camera_T_object: the pattern slides over the scene as in the real
+  // recording).
+  {
+    const std::vector<Rigid3> poses = ReadTum(config.render.trajectory).poses;
+    const int lags = std::end(kTemporalLags)[-1] + 1;
+    KinectSensorOptions options = config.sensor;
+    options.mode = SensorMode::kStructuredLight;
+    for (const bool moving : {false, true}) {
+      const std::string name = moving ? "view, SL, the real camera's motion" : "view, SL, still";
+      if (moving && static_cast<int>(poses.size()) < lags) {
+        ThrowBadValue(view.name + ": render.trajectory", std::to_string(poses.size()) + " poses",
+                      "at least " + std::to_string(lags) + " (the temporal lags)");
+      }
+      DepthSequence sequence{name, width, height, intrinsics, {}};
+      for (int k = 0; k < lags; ++k) {
+        const Rigid3 table_T_camera =
+            moving ? table_T_object * poses[k].Inverse() * scene.table_T_camera()
+                   : scene.table_T_camera();
+        KinectSensor sensor(options, &scene.scene(), table_T_camera);
+        const RgbdFrame frame = sensor.Render(k);
+        sequence.depth_m.push_back(DepthMetresFromUnits(frame.depth, frame.depth_scale));
+      }
+      report.view_temporal.push_back(TemporalStructure(name, sequence));
+    }
+  }
   // Structured light over speckle patterns: the first is the row above.
   report.pattern_near.push_back(report.like_for_like.back().structure);
   if (!rendered_away.empty()) report.pattern_away.push_back(report.like_for_like_away.back().structure);
@@ -294,6 +323,18 @@ std::string SensorCheckReport::Format() const {
     text += "\n";
   }
   if (!like_for_like.empty()) text += FormatLikeForLike();
+  if (!view_temporal.empty()) {
+    text += "\nthe real view over time: residual correlation with the first frame (as above)\n";
+    for (const TemporalRow& row : view_temporal) {
+      std::snprintf(line, sizeof(line), "%-40s", row.name.c_str());
+      text += line;
+      for (const TemporalCorrelation& t : row.lags) {
+        std::snprintf(line, sizeof(line), "  %14.3f (%5d)", t.rho, t.patches);
+        text += line;
+      }
+      text += "\n";
+    }
+  }
   return text;
 }
 
@@ -447,16 +488,20 @@ nlohmann::json SensorCheckReport::ToJson() const {
   for (size_t k = 0; k < structures.size(); ++k) {
     error_structure[structure_names[k]] = sim::ToJson(structures[k]);
   }
-  nlohmann::json temporal_json = nlohmann::json::array();
-  for (const TemporalRow& row : temporal) {
-    nlohmann::json lags = nlohmann::json::array();
-    for (size_t k = 0; k < row.lags.size(); ++k) {
-      lags.push_back({{"lag_frames", kTemporalLags[k]},
-                      {"rho", row.lags[k].rho},
-                      {"windows", row.lags[k].patches}});
+  auto temporal_rows = [](const std::vector<TemporalRow>& rows) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const TemporalRow& row : rows) {
+      nlohmann::json lags = nlohmann::json::array();
+      for (size_t k = 0; k < row.lags.size(); ++k) {
+        lags.push_back({{"lag_frames", kTemporalLags[k]},
+                        {"rho", row.lags[k].rho},
+                        {"windows", row.lags[k].patches}});
+      }
+      out.push_back({{"sequence", row.name}, {"lags", lags}});
     }
-    temporal_json.push_back({{"sequence", row.name}, {"lags", lags}});
-  }
+    return out;
+  };
+  const nlohmann::json temporal_json = temporal_rows(temporal);
   auto neighbourhoods = [](const std::vector<NeighbourhoodRow>& rows) {
     nlohmann::json like = nlohmann::json::array();
     for (const NeighbourhoodRow& row : rows) {
@@ -522,6 +567,7 @@ nlohmann::json SensorCheckReport::ToJson() const {
   if (!pattern_away.empty()) {
     result["like_for_like_away_patterns"] = over_patterns(like_for_like_away, pattern_away);
   }
+  if (!view_temporal.empty()) result["view_temporal_correlation"] = temporal_rows(view_temporal);
   if (real_near.size() > 1 && !pattern_near.empty()) {
     result["like_for_like_real_frames"] = over_real_frames(like_for_like, real_near, pattern_near);
   }

@@ -85,6 +85,10 @@ struct SensorCheckReport {
     std::vector<TemporalCorrelation> lags;  // one per kTemporalLags
   };
   std::vector<TemporalRow> temporal;
+  // The same for the like-for-like view in structured light (when a RealView is given): from a
+  // still camera, and moved as the real camera moved between the real frames (compare with the
+  // real sequence's row in `temporal`).
+  std::vector<TemporalRow> view_temporal;
   // Like for like (when a RealView is given): the real frame, then the view rendered in each mode
   // (statistical, structured light). pixel_scale turns the row's pixels into the rendered
   // sensor's (its focal length over the row's).
