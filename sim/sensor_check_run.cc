@@ -313,19 +313,8 @@ std::string SensorCheckReport::Format() const {
     text += line;
   }
   text += "\n";
-  for (const TemporalRow& row : temporal) {
-    std::snprintf(line, sizeof(line), "%-40s", row.name.c_str());
-    text += line;
-    for (const TemporalCorrelation& t : row.lags) {
-      std::snprintf(line, sizeof(line), "  %14.3f (%5d)", t.rho, t.patches);
-      text += line;
-    }
-    text += "\n";
-  }
-  if (!like_for_like.empty()) text += FormatLikeForLike();
-  if (!view_temporal.empty()) {
-    text += "\nthe real view over time: residual correlation with the first frame (as above)\n";
-    for (const TemporalRow& row : view_temporal) {
+  auto add_rows = [&](const std::vector<TemporalRow>& rows) {
+    for (const TemporalRow& row : rows) {
       std::snprintf(line, sizeof(line), "%-40s", row.name.c_str());
       text += line;
       for (const TemporalCorrelation& t : row.lags) {
@@ -334,6 +323,12 @@ std::string SensorCheckReport::Format() const {
       }
       text += "\n";
     }
+  };
+  add_rows(temporal);
+  if (!like_for_like.empty()) text += FormatLikeForLike();
+  if (!view_temporal.empty()) {
+    text += "\nthe real view over time: residual correlation with the first frame (as above)\n";
+    add_rows(view_temporal);
   }
   return text;
 }
