@@ -70,7 +70,8 @@ template <class T>
 struct IsFieldsVector : std::false_type {};
 template <class T>
 requires HasFields<T>
-struct IsFieldsVector<std::vector<T>> : std::true_type {};
+struct IsFieldsVector<std::vector<T>> : std::true_type {
+};
 
 // The closest known name within edit distance 2, or "".
 std::string SuggestName(const std::string& unknown, const std::vector<std::string>& known);

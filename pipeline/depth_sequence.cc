@@ -109,8 +109,7 @@ sim::RealView ReadRealView(const std::filesystem::path& folder, const std::files
   for (int k = 1; k < frames; ++k) {
     sim::RealView::Frame frame;
     frame.depth_m = std::move(sequence.depth_m[k]);
-    ReadLabels(LaterLabel(label, k), object, real.width, real.height, &frame.mask,
-               &frame.others);
+    ReadLabels(LaterLabel(label, k), object, real.width, real.height, &frame.mask, &frame.others);
     real.later_frames.push_back(std::move(frame));
   }
   Config config = Config::Load(view);

@@ -787,8 +787,8 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
       std::vector<float>& faces = s.face_ir_diffuse.back();
       faces.resize(mesh.face_count());
       for (int f = 0; f < mesh.face_count(); ++f) {
-        const int brightest = std::max({mesh.face_colors(f, 0), mesh.face_colors(f, 1),
-                                        mesh.face_colors(f, 2)});
+        const int brightest =
+            std::max({mesh.face_colors(f, 0), mesh.face_colors(f, 1), mesh.face_colors(f, 2)});
         faces[f] = static_cast<float>(
             s.object_ir_diffuse.back() *
             ((1.0 - material.colour_contrast) + material.colour_contrast * brightest / 255.0));

@@ -39,8 +39,8 @@ std::span<const std::pair<TableProps, const char*>> EnumNames(TableProps);
 // by table_T_object, e.g. the other objects of a real recording's view (docs/sensor.md, "At a
 // glance"). The pose is a translation [m] and a unit quaternion (x, y, z, w as in TUM files).
 struct SceneObject {
-  std::string name;  // unique, and none of the scene's own objects' names (BuildTableScene)
-  std::string mesh;  // an OBJ or PLY file, or a Duplo assembly (.json), as render.proxy
+  std::string name;    // unique, and none of the scene's own objects' names (BuildTableScene)
+  std::string mesh;    // an OBJ or PLY file, or a Duplo assembly (.json), as render.proxy
   double scale = 1.0;  // applied to the file's vertex positions (0.001 for millimetres)
   double x = 0.0, y = 0.0, z = 0.0;
   double qx = 0.0, qy = 0.0, qz = 0.0, qw = 1.0;  // norm within 1e-3 of 1; normalised on use
@@ -126,8 +126,8 @@ std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options);
 
 // The names BuildTableScene and the moving objects use; scene.objects may not take them.
 inline constexpr const char* kReservedObjectNames[] = {
-    "floor", "table", "play_area_tape", "like_box_tape", "backdrop", "castle", "proxy", "hand",
-    "slider"};
+    "floor",  "table", "play_area_tape", "like_box_tape", "backdrop",
+    "castle", "proxy", "hand",           "slider"};
 
 // The slider block: a green 2x2 Duplo brick, model frame as BuildDuploMesh (footprint centred, z =
 // 0 at its bottom), 31.8 mm square.

@@ -73,7 +73,8 @@ TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& pro
     try {
       mesh = LoadProxyModel(o.mesh, o.scale);
     } catch (const InputError& e) {
-      throw InputError("scene.objects[" + std::to_string(i) + "].mesh (" + o.name + "): " + e.what());
+      throw InputError("scene.objects[" + std::to_string(i) + "].mesh (" + o.name +
+                       "): " + e.what());
     }
     const uint32_t object = scene_.AddStatic(o.name, mesh, o.TableTObject());
     scene_.SetMaterial(object, o.material);

@@ -157,9 +157,9 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
                               real_away)});
     report.real_away.push_back(report.like_for_like_away.back().structure);
     for (const RealView::Frame& frame : view.later_frames) {
-      report.real_away.push_back(AnalyseNeighbourhood(
-          frame.depth_m, view.width, view.height, frame.mask, real_radius, {},
-          GrowMask(frame.others, view.width, view.height, real_radius)));
+      report.real_away.push_back(
+          AnalyseNeighbourhood(frame.depth_m, view.width, view.height, frame.mask, real_radius, {},
+                               GrowMask(frame.others, view.width, view.height, real_radius)));
     }
   }
   report.view_depth_m[0] = view.depth_m;
@@ -238,7 +238,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   }
   // Structured light over speckle patterns: the first is the row above.
   report.pattern_near.push_back(report.like_for_like.back().structure);
-  if (!rendered_away.empty()) report.pattern_away.push_back(report.like_for_like_away.back().structure);
+  if (!rendered_away.empty())
+    report.pattern_away.push_back(report.like_for_like_away.back().structure);
   report.pattern_seeds.push_back(config.sensor.structured_light.pattern_seed);
   for (int k = 1; k < view.patterns; ++k) {
     KinectSensorOptions options = config.sensor;
@@ -251,8 +252,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     report.pattern_near.push_back(
         AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx));
     if (!rendered_away.empty()) {
-      report.pattern_away.push_back(AnalyseNeighbourhood(depth_m, width, height, mask,
-                                                         kNeighbourhoodRadiusPx, {}, rendered_away));
+      report.pattern_away.push_back(AnalyseNeighbourhood(
+          depth_m, width, height, mask, kNeighbourhoodRadiusPx, {}, rendered_away));
     }
   }
 }

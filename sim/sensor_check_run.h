@@ -128,10 +128,10 @@ struct SensorCheckReport {
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
   std::string FormatLikeForLike() const;
-  static std::string FormatNeighbourhoods(const std::string& title,
-                                          const std::vector<NeighbourhoodRow>& rows,
-                                          const std::vector<NeighbourhoodStructure>& patterns = {},
-                                          const std::vector<NeighbourhoodStructure>& real_frames = {});
+  static std::string FormatNeighbourhoods(
+      const std::string& title, const std::vector<NeighbourhoodRow>& rows,
+      const std::vector<NeighbourhoodStructure>& patterns = {},
+      const std::vector<NeighbourhoodStructure>& real_frames = {});
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };

@@ -9,10 +9,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "core/rgbd_folder.h"
 #include "core/tum_io.h"
@@ -262,8 +261,8 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
     double real = 0, rendered = 0;
     for (int k = 0; k < 10; ++k) real += frames["frames"][k]["missing_share"].get<double>() / 10;
     for (int k = 0; k < 8; ++k) {
-      rendered += json[std::string(table) + "_patterns"]["patterns"][k]["missing_share"]
-                      .get<double>() / 8;
+      rendered +=
+          json[std::string(table) + "_patterns"]["patterns"][k]["missing_share"].get<double>() / 8;
     }
     EXPECT_NEAR(frames["ratio_of_means"]["missing_share"].get<double>(), rendered / real, 1e-12);
     // The real frames differ (the camera moves by millimetres), so the spread is not zero.
@@ -299,7 +298,8 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   const auto one = RunMmh("sensor-check --frames 1 --patterns 1");
   ASSERT_EQ(one.exit_code, 0) << one.output;
   EXPECT_THAT(one.output, Not(HasSubstr("patterns: SL/real")));
-  const auto zero = RunMmh("sensor-check --frames 1 --patterns 0 --out " + (dir_ / "zero").string());
+  const auto zero =
+      RunMmh("sensor-check --frames 1 --patterns 0 --out " + (dir_ / "zero").string());
   EXPECT_EQ(zero.exit_code, 2) << zero.output;
   EXPECT_THAT(zero.output, HasSubstr("--patterns"));
   EXPECT_FALSE(fs::exists(dir_ / "zero"));

@@ -346,7 +346,8 @@ TEST(Options, ListOfStructsRoundTripsAndReplacesTheDefaultList) {
 }
 
 TEST(Options, ListOfStructsErrorsNameTheElement) {
-  const std::string not_array = FromJsonError<ListOptions>(json::parse(R"({"blends": {"window": 3}})"));
+  const std::string not_array =
+      FromJsonError<ListOptions>(json::parse(R"({"blends": {"window": 3}})"));
   EXPECT_THAT(not_array, HasSubstr("montage.blends"));
   EXPECT_THAT(not_array, HasSubstr("an array of objects"));
   const std::string unknown =

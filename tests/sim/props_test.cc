@@ -156,8 +156,9 @@ TEST(TableSceneTest, ObjectsAreReadFromJsonAndValidated) {
   EXPECT_EQ(options.objects[1].material.ir_albedo, 0.5);
   EXPECT_NO_THROW(options.Validate("scene"));
   const Rigid3 table_T_mug = options.objects[0].TableTObject();
-  EXPECT_NEAR((table_T_mug * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0.1 + 0.28, 0.96, 0)).norm(),
-              0.0, 1e-12);  // a turn of 2 atan(0.6 / 0.8) = 73.7 deg about z
+  EXPECT_NEAR(
+      (table_T_mug * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0.1 + 0.28, 0.96, 0)).norm(), 0.0,
+      1e-12);  // a turn of 2 atan(0.6 / 0.8) = 73.7 deg about z
   EXPECT_EQ(ToJson(options)["objects"][1]["name"], "brick");
   auto expect_error = [&](auto change, const std::string& message) {
     TableSceneOptions o = options;
@@ -165,7 +166,8 @@ TEST(TableSceneTest, ObjectsAreReadFromJsonAndValidated) {
     EXPECT_THAT(ValidateError(o), HasSubstr(message));
   };
   expect_error([](auto& o) { o.objects[1].name = "mug"; }, "scene.objects[1].name: got \"mug\"");
-  expect_error([](auto& o) { o.objects[0].name = "table"; }, "scene.objects[0].name: got \"table\"");
+  expect_error([](auto& o) { o.objects[0].name = "table"; },
+               "scene.objects[0].name: got \"table\"");
   expect_error([](auto& o) { o.objects[0].name = ""; }, "scene.objects[0].name");
   expect_error([](auto& o) { o.objects[1].mesh = ""; }, "scene.objects[1].mesh");
   expect_error([](auto& o) { o.objects[0].qw = 0.9; }, "scene.objects[0].qx, qy, qz, qw");

@@ -23,8 +23,8 @@
 namespace mmh::sim {
 namespace {
 
-using ::testing::HasSubstr;
 using test_util::TempDir;
+using ::testing::HasSubstr;
 
 constexpr double kCube = 0.1;  // [m]
 
@@ -68,8 +68,8 @@ std::vector<DepthAt> ExactDepthAt(const RenderConfig& config,
     const int v = static_cast<int>(std::lround(uv.y()));
     EXPECT_TRUE(u >= 0 && v >= 0 && u < frame.depth_intrinsics.width &&
                 v < frame.depth_intrinsics.height);
-    result.push_back({depth[static_cast<size_t>(v) * frame.depth_intrinsics.width + u],
-                      camera_p.z()});
+    result.push_back(
+        {depth[static_cast<size_t>(v) * frame.depth_intrinsics.width + u], camera_p.z()});
   }
   return result;
 }
