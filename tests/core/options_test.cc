@@ -83,9 +83,17 @@ struct CountOptions {
   void Validate(const std::string&) const {}
 };
 
+// A default list of one element (built with push_back: from an initializer list GCC 12 warns,
+// wrongly, that the element's copy may be uninitialised).
+std::vector<BlendOptions> OneBlend() {
+  std::vector<BlendOptions> blends;
+  blends.push_back({3, Weight::kSmoothstep});
+  return blends;
+}
+
 // A list of nested structs (a JSON array of objects).
 struct ListOptions {
-  std::vector<BlendOptions> blends = {BlendOptions{3, Weight::kSmoothstep}};
+  std::vector<BlendOptions> blends = OneBlend();
   int after = 1;
   template <class V>
   void VisitFields(V& v) {
