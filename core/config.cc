@@ -61,11 +61,21 @@ void Config::Set(const std::string& assignment) {
   overrides_[key_path] = assignment;
 }
 
+namespace {
+
+// A --set of `key` wrote (part of) the value at `key_path`: the same key, one below it or one
+// above it.
+bool SetReaches(const std::string& key, const std::string& key_path) {
+  return key == key_path || key.rfind(key_path + ".", 0) == 0 || key_path.rfind(key + ".", 0) == 0;
+}
+
+}  // namespace
+
 ConfigSource Config::SourceOf(const std::string& key_path) const {
   // The most specific --set at or below this key wins; otherwise the file.
   std::string sets;
   for (const auto& [key, assignment] : overrides_) {
-    if (key == key_path || key.rfind(key_path + ".", 0) == 0 || key_path.rfind(key + ".", 0) == 0) {
+    if (SetReaches(key, key_path)) {
       sets += (sets.empty() ? "" : ", ") + ("--set " + assignment);
     }
   }
@@ -76,9 +86,7 @@ ConfigSource Config::SourceOf(const std::string& key_path) const {
 
 std::filesystem::path Config::FolderOf(const std::string& key_path) const {
   for (const auto& [key, assignment] : overrides_) {
-    if (key == key_path || key.rfind(key_path + ".", 0) == 0 || key_path.rfind(key + ".", 0) == 0) {
-      return {};
-    }
+    if (SetReaches(key, key_path)) return {};
   }
   if (file_.empty()) return {};
   return std::filesystem::path(file_).parent_path();

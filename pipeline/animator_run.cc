@@ -119,6 +119,7 @@ ProxyModels LoadProxyModels(const RunConfig& config, const RunScripts& scripts) 
     models.meshes.push_back(sim::LoadProxyModel(practice_proxy, 1.0));
     models.names.push_back(practice_proxy.empty() ? "the Soldier" : practice_proxy);
   }
+  models.scene_objects = sim::LoadSceneObjects(config.render.scene);
   return models;
 }
 

@@ -30,6 +30,7 @@ struct SessionJob {
   bool annotation = false;
   const TriangleMesh* model = nullptr;
   std::string model_name;
+  const std::vector<TriangleMesh>* scene_objects = nullptr;  // ProxyModels::scene_objects
   sim::SessionFrames frames;
   // Results.
   track::TrackRun run;
@@ -43,7 +44,7 @@ void RunSession(const sim::RenderConfig& render, const track::ProxyTrackerOption
                 const track::SliderReaderOptions& slider, SessionJob& job,
                 const std::function<void()>& frame_done) {
   const auto start = Clock::now();
-  sim::TableTopScene scene(render, *job.model);
+  sim::TableTopScene scene(render, *job.model, *job.scene_objects);
   sim::KinectSensor sensor(render.sensor, &scene.scene(), scene.table_T_camera());
   job.camera_T_table = sensor.world_T_depth_camera().Inverse();
   const int frames = static_cast<int>(job.frames.table_T_proxy.size());
@@ -111,6 +112,7 @@ int RecordSessions(const RunConfig& config, const RunScripts& scripts, const Pro
     recording.take_slot = static_cast<int>(slot);
     recording.model = &models.meshes[model];
     recording.model_name = models.names[model];
+    recording.scene_objects = &models.scene_objects;
     recording.frames = take_script.RecordingFrames(t.performed, frames);
     jobs.push_back(std::move(recording));
     total_frames += frames;
@@ -120,6 +122,7 @@ int RecordSessions(const RunConfig& config, const RunScripts& scripts, const Pro
       annotation.annotation = true;
       annotation.model = &models.meshes[model];
       annotation.model_name = models.names[model];
+      annotation.scene_objects = &models.scene_objects;
       annotation.frames = take_script.AnnotationFrames(t.annotation, frames);
       jobs.push_back(std::move(annotation));
       total_frames += frames;

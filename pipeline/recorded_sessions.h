@@ -30,6 +30,9 @@ struct RunScripts {
 struct ProxyModels {
   std::vector<TriangleMesh> meshes;
   std::vector<std::string> names;  // for messages: the file, or "the Soldier"
+  // The scene's own static objects (sim::LoadSceneObjects of the render config's scene), loaded
+  // once for every session.
+  std::vector<TriangleMesh> scene_objects;
 };
 
 // Renders and tracks every session of the takes not `loaded` (the recording of each, and the

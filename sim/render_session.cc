@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -62,21 +63,23 @@ void LinkBopImages(const std::filesystem::path& staging,
 }  // namespace
 
 TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model)
+    : TableTopScene(config, proxy_model, LoadSceneObjects(config.scene)) {}
+
+TableTopScene::TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model,
+                             const std::vector<TriangleMesh>& object_meshes)
     : config_(config), table_T_camera_(config.camera.TableTCamera()) {
+  if (object_meshes.size() != config.scene.objects.size()) {
+    throw std::logic_error("TableTopScene: " + std::to_string(object_meshes.size()) +
+                           " object meshes for " + std::to_string(config.scene.objects.size()) +
+                           " scene.objects");
+  }
   for (const NamedMesh& part : BuildTableScene(config.scene)) {
     const uint32_t object = scene_.AddStatic(part.name, part.mesh, Rigid3::Identity());
     scene_.SetMaterial(object, config.scene.materials.ForObject(part.name));
   }
   for (size_t i = 0; i < config.scene.objects.size(); ++i) {
     const SceneObject& o = config.scene.objects[i];
-    TriangleMesh mesh;
-    try {
-      mesh = LoadProxyModel(o.mesh, o.scale);
-    } catch (const InputError& e) {
-      throw InputError("scene.objects[" + std::to_string(i) + "].mesh (" + o.name +
-                       "): " + e.what());
-    }
-    const uint32_t object = scene_.AddStatic(o.name, mesh, o.TableTObject());
+    const uint32_t object = scene_.AddStatic(o.name, object_meshes[i], o.TableTObject());
     scene_.SetMaterial(object, o.material);
   }
   proxy_ = scene_.AddMoving("proxy", proxy_model);
@@ -258,8 +261,9 @@ void WriteStoryFiles(const Motion& motion, const people::PeopleConfig& people,
 struct SceneWorkers {
   SceneWorkers(const RenderConfig& config, const TriangleMesh& proxy_model, const Motion& motion,
                int count) {
+    const std::vector<TriangleMesh> object_meshes = LoadSceneObjects(config.scene);
     for (int w = 0; w < count; ++w) {
-      scenes.push_back(std::make_unique<TableTopScene>(config, proxy_model));
+      scenes.push_back(std::make_unique<TableTopScene>(config, proxy_model, object_meshes));
       sensors.push_back(std::make_unique<KinectSensor>(config.sensor, &scenes.back()->scene(),
                                                        scenes.back()->table_T_camera()));
       TableTopScene* scene = scenes.back().get();

@@ -147,9 +147,17 @@ struct RenderConfig {
 // The proxy's model in its own frame, from RenderOptions::proxy.
 TriangleMesh LoadProxyModel(const std::string& proxy, double scale);
 
-// The scene of one recording: static table top, proxy, hand, slider block.
+// The meshes of config `scene.objects`, in their order (file I/O: load them once for all the
+// scenes of a recording). A missing or bad file is an InputError naming scene.objects[i].mesh.
+std::vector<TriangleMesh> LoadSceneObjects(const TableSceneOptions& scene);
+
+// The scene of one recording: static table top, the user's objects, proxy, hand, slider block.
 class TableTopScene {
  public:
+  // `object_meshes`: LoadSceneObjects(config.scene).
+  TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model,
+                const std::vector<TriangleMesh>& object_meshes);
+  // Loads the objects' meshes itself (a single scene).
   TableTopScene(const RenderConfig& config, const TriangleMesh& proxy_model);
   enum class Hand { kOnProxy, kOnSlider };
   // Places the proxy, the slider block and the hand holding one of them; commits the scene.

@@ -82,6 +82,40 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
 
 // The real view rendered in both modes, and each frame's neighbourhood of the object beside the
 // real frame's (docs/sensor.md, "Like for like").
+// The like-for-like view over time in structured light (SensorCheckReport::view_temporal): frames
+// 0 .. the last lag from a still camera (only the IR noise changes), and with the real camera's
+// motion. The trajectory's object poses are the real camera_T_object carried into the table frame
+// through the first frame's table fit, so a still object seen by camera_k = table_T_object_0
+// table_T_object_k^-1 table_T_camera has the real frame k's camera_T_object: the pattern slides
+// over the scene as in the real recording. `first_m`: frame 0, rendered already (the scene posed
+// at poses[0]).
+std::vector<SensorCheckReport::TemporalRow> ViewOverTime(const std::string& view_name,
+                                                         const TableTopScene& scene,
+                                                         KinectSensorOptions options,
+                                                         const std::vector<Rigid3>& poses,
+                                                         std::vector<float> first_m,
+                                                         const PinholeIntrinsics& intrinsics) {
+  const int lags = std::end(kTemporalLags)[-1] + 1;
+  if (static_cast<int>(poses.size()) < lags) {
+    ThrowBadValue(view_name + ": render.trajectory", std::to_string(poses.size()) + " poses",
+                  "at least " + std::to_string(lags) + " (the temporal lags)");
+  }
+  options.mode = SensorMode::kStructuredLight;
+  DepthSequence still{"view, SL, still", intrinsics.width, intrinsics.height, intrinsics, {first_m}};
+  DepthSequence moving{"view, SL, the real camera's motion", intrinsics.width, intrinsics.height,
+                       intrinsics, {std::move(first_m)}};
+  KinectSensor still_sensor(options, &scene.scene(), scene.table_T_camera());
+  for (int k = 1; k < lags; ++k) {
+    const RgbdFrame frame = still_sensor.Render(k);
+    still.depth_m.push_back(DepthMetresFromUnits(frame.depth, frame.depth_scale));
+    KinectSensor moved(options, &scene.scene(),
+                       poses.front() * poses[k].Inverse() * scene.table_T_camera());
+    const RgbdFrame moved_frame = moved.Render(k);
+    moving.depth_m.push_back(DepthMetresFromUnits(moved_frame.depth, moved_frame.depth_scale));
+  }
+  return {TemporalStructure(still.name, still), TemporalStructure(moving.name, moving)};
+}
+
 void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const RenderConfig& config = view.config;
   if (config.render.trajectory.empty()) {
@@ -89,7 +123,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
                   "the object's poses, the first the real frame's");
   }
   // ReadTum refuses a file without poses.
-  const Rigid3 table_T_object = ReadTum(config.render.trajectory).poses.front();
+  const std::vector<Rigid3> poses = ReadTum(config.render.trajectory).poses;
+  const Rigid3& table_T_object = poses.front();
   TableTopScene scene(config, LoadProxyModel(config.render.proxy, config.render.proxy_scale));
   // The object's mask: where the exact depth with the object is valid and nearer than without it
   // (the object moved far below the floor).
@@ -186,6 +221,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   };
   report.native_view_depth_m[0] = on_native_grid(view.depth_m, view.intrinsics);
   scene.SetFrame(table_T_object, 0.0);
+  std::vector<float> structured_depth_m;  // the structured-light frame, for the view over time
   for (const SensorMode mode : {SensorMode::kStatistical, SensorMode::kStructuredLight}) {
     KinectSensorOptions options = config.sensor;
     options.mode = mode;
@@ -206,36 +242,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
     report.native_view_depth_m[structured ? 2 : 1] = on_native_grid(depth_m, intrinsics);
+    if (structured) structured_depth_m = std::move(depth_m);
   }
-  // Errors over time in the view, structured light: frames 0 .. the last lag from a still camera
-  // (only the IR noise changes), and with the real camera's motion (the trajectory's object poses
-  // are the real camera_T_object carried into the table frame through the first frame's table
-  // fit, so a still object seen by camera_k = table_T_object_0 table_T_object_k^-1 table_T_camera
-  // has the real frame k's camera_T_object: the pattern slides over the scene as in the real
-  // recording).
-  {
-    const std::vector<Rigid3> poses = ReadTum(config.render.trajectory).poses;
-    const int lags = std::end(kTemporalLags)[-1] + 1;
-    KinectSensorOptions options = config.sensor;
-    options.mode = SensorMode::kStructuredLight;
-    for (const bool moving : {false, true}) {
-      const std::string name = moving ? "view, SL, the real camera's motion" : "view, SL, still";
-      if (moving && static_cast<int>(poses.size()) < lags) {
-        ThrowBadValue(view.name + ": render.trajectory", std::to_string(poses.size()) + " poses",
-                      "at least " + std::to_string(lags) + " (the temporal lags)");
-      }
-      DepthSequence sequence{name, width, height, intrinsics, {}};
-      for (int k = 0; k < lags; ++k) {
-        const Rigid3 table_T_camera =
-            moving ? table_T_object * poses[k].Inverse() * scene.table_T_camera()
-                   : scene.table_T_camera();
-        KinectSensor sensor(options, &scene.scene(), table_T_camera);
-        const RgbdFrame frame = sensor.Render(k);
-        sequence.depth_m.push_back(DepthMetresFromUnits(frame.depth, frame.depth_scale));
-      }
-      report.view_temporal.push_back(TemporalStructure(name, sequence));
-    }
-  }
+  report.view_temporal = ViewOverTime(view.name, scene, config.sensor, poses,
+                                      std::move(structured_depth_m), intrinsics);
   // Structured light over speckle patterns: the first is the row above.
   report.pattern_near.push_back(report.like_for_like.back().structure);
   if (!rendered_away.empty())
