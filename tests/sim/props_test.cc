@@ -143,6 +143,65 @@ TEST(TableSceneTest, ValidateNamesTheFieldAndValue) {
   EXPECT_NO_THROW(TableSceneOptions{}.Validate("scene"));
 }
 
+// A real scene's desk (the views of tests/data/real/ycbv): the top moved and turned, no tape.
+TEST(TableSceneTest, TableTopMovedAndTurnedWithoutTape) {
+  TableSceneOptions o;
+  o.table_x = 0.2;
+  o.table_y = 0.4;
+  o.table_yaw_deg = -30;
+  o.table_width = 2.0;
+  o.table_depth = 1.2;
+  o.tape_thickness = 0;
+  o.play_area_width = o.play_area_depth = 0.1;
+  o.backdrop = false;
+  const auto scene = SceneByName(o);
+  EXPECT_FALSE(scene.count("play_area_tape"));
+  EXPECT_FALSE(scene.count("like_box_tape"));
+  const TriangleMesh& table = scene.at("table");
+  EXPECT_TRUE(IsClosed(table));
+  EXPECT_NEAR(SignedVolume(table), 2.0 * 1.2 * 0.03 + 4 * 0.05 * 0.05 * 0.72, 1e-5);
+  // The front edge's middle is 0.6 m from the centre along the top's -y, its y axis turned by
+  // -30 deg: (0.2, 0.4) - 0.6 (-sin(-30), cos(-30)) = (-0.1, -0.1196); the top's corners are
+  // its extremes in x and y.
+  const double c = std::cos(-30 * M_PI / 180), s = std::sin(-30 * M_PI / 180);
+  double min_y = 1e9, max_x = -1e9;
+  for (const double x : {-1.0, 1.0}) {
+    for (const double y : {-0.6, 0.6}) {
+      min_y = std::min(min_y, 0.4 + s * x + c * y);
+      max_x = std::max(max_x, 0.2 + c * x - s * y);
+    }
+  }
+  const Bounds3 b = ComputeBounds(table);
+  EXPECT_NEAR(b.min.y(), min_y, 1e-6);
+  EXPECT_NEAR(b.max.x(), max_x, 1e-6);
+  EXPECT_NEAR(b.max.z(), 0.0, 1e-9);
+  const Eigen::Vector3d front = o.TableTTop() * Eigen::Vector3d(0, -0.6, 0);
+  EXPECT_NEAR(front.x(), -0.1, 1e-9);
+  EXPECT_NEAR(front.y(), 0.4 - 0.6 * c, 1e-9);
+
+  // A play area that reaches over the turned top's front edge (its middle at (-0.1, 0.03))
+  // names the key and the turn.
+  o.table_y = 0.55;
+  o.play_area_width = o.play_area_depth = 0.3;
+  EXPECT_THAT(ValidateError(o), HasSubstr("scene.play_area_"));
+  EXPECT_THAT(ValidateError(o), HasSubstr("turned -30 deg"));
+  o.table_y = 0.4;
+  o.play_area_width = o.play_area_depth = 0.1;
+  o.backdrop = true;
+  o.backdrop_y = 0.9;  // in front of the far corner, 0.4 + 0.5 + 0.52
+  EXPECT_THAT(ValidateError(o), HasSubstr("scene.backdrop_y: got 0.9"));
+  EXPECT_THAT(ValidateError(o), HasSubstr("the table's far corner"));
+  o.backdrop = false;
+  o.table_yaw_deg = 200;
+  EXPECT_THAT(ValidateError(o), HasSubstr("scene.table_yaw_deg: got 200"));
+  o.table_yaw_deg = 0;
+  o.table_x = std::numeric_limits<double>::infinity();
+  EXPECT_THAT(ValidateError(o), HasSubstr("scene.table_x: got inf"));
+  o.table_x = 0;
+  o.tape_thickness = -0.001;
+  EXPECT_THAT(ValidateError(o), HasSubstr("scene.tape_thickness: got -0.001"));
+}
+
 TEST(TableSceneTest, ObjectsAreReadFromJsonAndValidated) {
   TableSceneOptions options;
   FromJson(nlohmann::json::parse(R"({"objects": [

@@ -19,9 +19,17 @@ defaults but the proxy's, a matte printed box) and table_T_proxy.tum:
                    on the same recording with that object's label), carried into the table frame
                    through the first track folder's table fit; MODEL is written relative to OUT;
                    ALBEDO and SPECULARITY are its IR material.
+  --desk DEPTH_PNG  fits the desk the objects stand on from that real depth frame (YCB-Video's
+                   16-bit depth, 1/10000 m, registered to the colour camera of --intrinsics): its
+                   front edge, where the table top's points meet the floor's (a line in the table
+                   frame, least squares over the image rows that cross it), and the floor's height
+                   below the top (median); writes scene.table_x, table_y, table_yaw_deg (a top of
+                   --desk-size whose front edge is that line), table_height, no tape (the real
+                   scene has none: tape_thickness 0, a 0.1 m play area that stays on the desk) and
+                   no wall (the floor beyond the desk, as in the real frame). Needs numpy.
 The camera is placed at the real camera's position in the table frame, looking at the point where
 the real optical axis meets the table; a look-at camera has no roll, so the real camera's roll
-about its axis (a few degrees) is not reproduced. Standard library only.
+about its axis (a few degrees) is not reproduced. Standard library only, but for --desk.
 """
 import argparse
 import json
@@ -56,6 +64,107 @@ def inverse(r, t):
     return rt, [-sum(rt[i][k] * t[k] for k in range(3)) for i in range(3)]
 
 
+def read_depth_png(path):
+    """A 16-bit greyscale PNG as a numpy array of rows (PNG's five row filters undone)."""
+    import numpy as np
+    import struct
+    import zlib
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise SystemExit(f"{path}: not a PNG file")
+    at, idat, header = 8, [], None
+    while at < len(data):
+        size, kind = struct.unpack(">I4s", data[at:at + 8])
+        chunk = data[at + 8:at + 8 + size]
+        at += 12 + size
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", chunk)
+        elif kind == b"IDAT":
+            idat.append(chunk)
+    width, height, bits, colour = header[:4]
+    if bits != 16 or colour != 0 or header[6] != 0:
+        raise SystemExit(f"{path}: {bits}-bit colour type {colour} (interlace {header[6]}); "
+                         "expected a non-interlaced 16-bit greyscale depth image")
+    raw = zlib.decompress(b"".join(idat))
+    stride = 2 * width
+    rows = np.zeros((height, stride), np.int32)
+    previous = np.zeros(stride, np.int32)
+    for v in range(height):
+        kind = raw[v * (stride + 1)]
+        line = np.frombuffer(raw, np.uint8, stride, v * (stride + 1) + 1).astype(np.int32)
+        if kind == 0:
+            row = line
+        elif kind == 2:
+            row = (line + previous) & 255
+        else:  # Sub, Average, Paeth: each byte depends on the one two bytes (one pixel) left
+            row = np.zeros(stride, np.int32)
+            for u in range(stride):
+                a = row[u - 2] if u >= 2 else 0
+                b = previous[u]
+                c = previous[u - 2] if u >= 2 else 0
+                if kind == 1:
+                    x = a
+                elif kind == 3:
+                    x = (a + b) >> 1
+                else:
+                    p = a + b - c
+                    pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                    x = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                row[u] = (line[u] + x) & 255
+        rows[v] = row
+        previous = row
+    return (rows[:, 0::2] << 8) | rows[:, 1::2]
+
+
+def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
+    """The desk's scene keys from a real depth frame (see --desk)."""
+    import numpy as np
+    depth = read_depth_png(depth_png) / 10000.0
+    fx, fy, cx, cy = intrinsics
+    v, u = np.mgrid[0:depth.shape[0], 0:depth.shape[1]]
+    camera = np.stack([(u - cx) / fx * depth, (v - cy) / fy * depth, depth], -1)
+    table = camera @ np.array(r_tc).T + np.array(t_tc)  # table_p = table_R_camera camera_p + t
+    valid = depth > 0
+    on_top = valid & (np.abs(table[..., 2]) < 0.01)
+    on_floor = valid & (table[..., 2] < -0.3)
+    # Per image row, the table-top pixel nearest to the floor's pixels on its left or right,
+    # where the row crosses the desk's edge (missing pixels between are allowed).
+    edge = []
+    for row in range(depth.shape[0]):
+        floor_u = np.flatnonzero(on_floor[row])
+        top_u = np.flatnonzero(on_top[row])
+        if len(floor_u) < 5 or len(top_u) < 5:
+            continue
+        if floor_u.max() < top_u.min():
+            edge.append(table[row, top_u.min(), :2])
+        elif top_u.max() < floor_u.min():
+            edge.append(table[row, top_u.max(), :2])
+    if len(edge) < 10:
+        raise SystemExit(f"{depth_png}: {len(edge)} image rows cross the desk's edge; "
+                         "expected at least 10 (a frame showing the floor beside the desk)")
+    edge = np.array(edge)
+    # Total least squares: the edge's direction is the principal axis of its points.
+    centre = edge.mean(0)
+    direction = np.linalg.svd(edge - centre)[2][0]
+    inward = np.array([-direction[1], direction[0]])
+    top_centroid = table[on_top][:, :2].mean(0)
+    if (top_centroid - centre) @ inward < 0:
+        inward = -inward
+    residual = (edge - centre) @ inward
+    width, depth_m = size
+    x_axis = np.array([inward[1], -inward[0]])  # the top's +y is inward, its +x to the right
+    middle = centre + 0.5 * depth_m * inward
+    floor_z = float(np.median(table[on_floor][:, 2]))
+    print(f"desk: front edge through ({centre[0]:.3f}, {centre[1]:.3f}) m along "
+          f"({direction[0]:.3f}, {direction[1]:.3f}), {len(edge)} rows, rms "
+          f"{1000 * np.sqrt((residual ** 2).mean()):.1f} mm; floor {-floor_z:.3f} m below the top")
+    return {"table_x": float(middle[0]), "table_y": float(middle[1]),
+            "table_yaw_deg": math.degrees(math.atan2(x_axis[1], x_axis[0])),
+            "table_width": width, "table_depth": depth_m, "table_height": -floor_z,
+            "tape_thickness": 0.0, "play_area_width": 0.1, "play_area_depth": 0.1,
+            "backdrop": False}
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("track_folder")
@@ -68,6 +177,13 @@ def main():
     parser.add_argument("--other", nargs=5, action="append", default=[],
                         metavar=("TRACK", "MODEL", "NAME", "ALBEDO", "SPECULARITY"),
                         help="another object of the frame, static (scene.objects)")
+    parser.add_argument("--desk", metavar="DEPTH_PNG",
+                        help="fit the desk's front edge and the floor from this real depth frame")
+    parser.add_argument("--desk-size", nargs=2, type=float, default=[2.0, 1.2],
+                        metavar=("WIDTH", "DEPTH"), help="the desk top's size [m]")
+    parser.add_argument("--intrinsics", nargs=4, type=float, metavar=("FX", "FY", "CX", "CY"),
+                        default=[1066.778, 1067.487, 312.9869, 241.3109],
+                        help="the depth frame's pinhole intrinsics (YCB-Video's colour camera)")
     parser.add_argument("--no-paths", dest="paths", action="store_false",
                         help="leave render.proxy and render.trajectory out of render.json (given "
                              "with --set instead: the committed views/ of the tests)")
@@ -138,6 +254,8 @@ def main():
         "scene": {"materials": {"proxy": {"ir_albedo": args.ir_albedo,
                                           "specularity": args.specularity}}},
     }
+    if args.desk:
+        config["scene"].update(fit_desk(args.desk, args.intrinsics, r_tc, t_tc, args.desk_size))
     if objects:
         config["scene"]["objects"] = objects
     name = "render.json" if args.paths else stem + ".json"
