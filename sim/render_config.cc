@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <string>
 
 #include "core/error.h"
@@ -54,6 +55,10 @@ void CameraPlacement::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".look_at", "a point " + FormatNumber(forward.norm()) + " m away",
                   "a point at least 0.1 m from the camera");
   }
+  if (!std::isfinite(roll_deg) || std::abs(roll_deg) > 180.0) {
+    ThrowBadValue(prefix + ".roll_deg", FormatNumber(roll_deg),
+                  "a turn about the viewing axis in [-180, 180] degrees");
+  }
   if (forward.normalized().cross(Eigen::Vector3d::UnitZ()).norm() < 1e-3) {
     ThrowBadValue(prefix + ".look_at", "straight up or down",
                   "a viewing direction that is not vertical (the image x axis is kept "
@@ -72,6 +77,11 @@ Rigid3 CameraPlacement::TableTCamera() const {
   r.col(0) = right;
   r.col(1) = down;
   r.col(2) = forward;
+  if (roll_deg != 0) {
+    // x' = cos(roll) right + sin(roll) down: the image turned about the viewing axis.
+    r = r * Eigen::AngleAxisd(roll_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ())
+                .toRotationMatrix();
+  }
   return Rigid3(Eigen::Quaterniond(r).normalized(), position);
 }
 

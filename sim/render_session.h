@@ -42,6 +42,10 @@ std::span<const std::pair<RenderSession, const char*>> EnumNames(RenderSession);
 struct CameraPlacement {
   double x = 0.0, y = -0.65, z = 0.55;                       // [m]
   double look_at_x = 0.0, look_at_y = 0.0, look_at_z = 0.0;  // [m]
+  // The camera turned about its viewing axis [deg], from the look-at pose whose image x axis is
+  // horizontal, towards its image y (down): a real camera's roll (the real views of
+  // tests/data/real/ycbv/views).
+  double roll_deg = 0.0;
 
   template <class V>
   void VisitFields(V& v) {
@@ -51,6 +55,7 @@ struct CameraPlacement {
     v("look_at_x", look_at_x);
     v("look_at_y", look_at_y);
     v("look_at_z", look_at_z);
+    v("roll_deg", roll_deg);
   }
   void Validate(const std::string& prefix) const;
   // table_T_camera (camera frame: x right, y down, z forward).

@@ -116,6 +116,37 @@ std::vector<SensorCheckReport::TemporalRow> ViewOverTime(const std::string& view
   return {TemporalStructure(still.name, still), TemporalStructure(moving.name, moving)};
 }
 
+// A desk's front edge in a depth image of the bare geometry (width x height, metres, no pixel
+// missing but beyond the range; the depth camera at table_T_camera): the pixels of the table top
+// (at most 5 cm below it, in the table frame) with a 4-neighbour on the floor beyond the desk
+// (more than 5 cm below the top). None in a view whose table reaches past the picture.
+std::vector<uint8_t> DeskEdgeMask(const std::vector<float>& depth_m,
+                                  const PinholeIntrinsics& intrinsics,
+                                  const Rigid3& table_T_camera) {
+  const int width = intrinsics.width, height = intrinsics.height;
+  constexpr double kBelowTop = -0.05;            // [m]
+  std::vector<int8_t> level(depth_m.size(), 0);  // 1: the top (or above it), -1: below, 0: none
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t p = static_cast<size_t>(v) * width + u;
+      const double z = depth_m[p];
+      if (!(z > 0)) continue;
+      const Eigen::Vector3d camera_p((u - intrinsics.cx) / intrinsics.fx * z,
+                                     (v - intrinsics.cy) / intrinsics.fy * z, z);
+      level[p] = (table_T_camera * camera_p).z() < kBelowTop ? -1 : 1;
+    }
+  }
+  std::vector<uint8_t> edge(depth_m.size(), 0);
+  for (int v = 1; v + 1 < height; ++v) {
+    for (int u = 1; u + 1 < width; ++u) {
+      const size_t p = static_cast<size_t>(v) * width + u;
+      edge[p] = level[p] == 1 && (level[p - 1] == -1 || level[p + 1] == -1 ||
+                                  level[p - width] == -1 || level[p + width] == -1);
+    }
+  }
+  return edge;
+}
+
 void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const RenderConfig& config = view.config;
   if (config.render.trajectory.empty()) {
@@ -197,6 +228,57 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
                                GrowMask(frame.others, view.width, view.height, real_radius)));
     }
   }
+  // Along the desk's edge: its pixels in the bare geometry (the exact render without the object,
+  // the IR shadow, the IR camera's occlusion and the missing-pixel rules, so that the top's and the
+  // floor's pixels meet), grown as the object's mask is, the object's and the other objects'
+  // neighbourhoods left out; mapped to the real grid as the other objects' mask is mapped to the
+  // rendered one.
+  KinectSensorOptions bare = exact;
+  bare.missing.edge_probability = 0;
+  bare.missing.speckle_probability = 0;
+  bare.missing.grazing_from_deg = 89;
+  bare.missing.grazing_to_deg = 90;
+  bare.missing.projector_shadow = false;
+  bare.missing.ir_camera_occlusion = false;
+  scene.SetFrame(Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, -100)), 0.0);
+  KinectSensor bare_sensor(bare, &scene.scene(), scene.table_T_camera());
+  const RgbdFrame bare_frame = bare_sensor.Render(0);
+  const std::vector<uint8_t> rendered_desk =
+      DeskEdgeMask(DepthMetresFromUnits(bare_frame.depth, bare_frame.depth_scale), intrinsics,
+                   bare_sensor.world_T_depth_camera());
+  const bool desk =
+      std::find(rendered_desk.begin(), rendered_desk.end(), uint8_t{1}) != rendered_desk.end();
+  std::vector<uint8_t> rendered_desk_out = GrowMask(mask, width, height, kNeighbourhoodRadiusPx);
+  if (!rendered_away.empty()) {
+    for (size_t p = 0; p < rendered_desk_out.size(); ++p) {
+      rendered_desk_out[p] = rendered_desk_out[p] || rendered_away[p];
+    }
+  }
+  if (desk) {
+    const std::vector<float> desk_m(rendered_desk.begin(), rendered_desk.end());
+    const std::vector<float> out_m(rendered_desk_out.begin(), rendered_desk_out.end());
+    const std::vector<float> real_desk_m =
+        ResampleDepthNearest(desk_m, intrinsics, view.intrinsics);
+    const std::vector<float> real_out_m = ResampleDepthNearest(out_m, intrinsics, view.intrinsics);
+    std::vector<uint8_t> real_desk(real_desk_m.size()), real_out(real_out_m.size());
+    for (size_t p = 0; p < real_desk.size(); ++p) {
+      real_desk[p] = real_desk_m[p] > 0.5f;
+      real_out[p] = real_out_m[p] > 0.5f;
+    }
+    report.like_for_like_desk.push_back(
+        {view.name, real_scale,
+         AnalyseNeighbourhood(view.depth_m, view.width, view.height, real_desk, real_radius, {},
+                              real_out)});
+    report.real_desk.push_back(report.like_for_like_desk.back().structure);
+    for (const RealView::Frame& frame : view.later_frames) {
+      report.real_desk.push_back(AnalyseNeighbourhood(frame.depth_m, view.width, view.height,
+                                                      real_desk, real_radius, {}, real_out));
+    }
+  }
+  auto analyse_desk = [&](const std::vector<float>& depth_m) {
+    return AnalyseNeighbourhood(depth_m, width, height, rendered_desk, kNeighbourhoodRadiusPx, {},
+                                rendered_desk_out);
+  };
   report.view_depth_m[0] = view.depth_m;
   report.view_width = view.width;
   report.view_height = view.height;
@@ -238,6 +320,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
            AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx, {},
                                 rendered_away)});
     }
+    if (desk) {
+      report.like_for_like_desk.push_back(
+          {structured ? "view, SL" : "view, stat.", 1.0, analyse_desk(depth_m)});
+    }
     // The picture shows the rendered frame at the real one's scale and field of view.
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
@@ -250,6 +336,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   report.pattern_near.push_back(report.like_for_like.back().structure);
   if (!rendered_away.empty())
     report.pattern_away.push_back(report.like_for_like_away.back().structure);
+  if (desk) report.pattern_desk.push_back(report.like_for_like_desk.back().structure);
   report.pattern_seeds.push_back(config.sensor.structured_light.pattern_seed);
   for (int k = 1; k < view.patterns; ++k) {
     KinectSensorOptions options = config.sensor;
@@ -265,6 +352,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
       report.pattern_away.push_back(AnalyseNeighbourhood(
           depth_m, width, height, mask, kNeighbourhoodRadiusPx, {}, rendered_away));
     }
+    if (desk) report.pattern_desk.push_back(analyse_desk(depth_m));
   }
 }
 
@@ -357,6 +445,13 @@ std::string SensorCheckReport::FormatLikeForLike() const {
                   "grown by %d px, left out of both)\n",
                   kNeighbourhoodRadiusPx);
     text += FormatNeighbourhoods(title, like_for_like_away, pattern_away, real_away);
+  }
+  if (!like_for_like_desk.empty()) {
+    std::snprintf(title, sizeof(title),
+                  "\nlike for like, along the desk's edge (the table top's pixels beside the "
+                  "floor's grown by %d px, the objects' left out)\n",
+                  kNeighbourhoodRadiusPx);
+    text += FormatNeighbourhoods(title, like_for_like_desk, pattern_desk, real_desk);
   }
   return text;
 }
@@ -580,6 +675,14 @@ nlohmann::json SensorCheckReport::ToJson() const {
   if (real_away.size() > 1 && !pattern_away.empty()) {
     result["like_for_like_away_real_frames"] =
         over_real_frames(like_for_like_away, real_away, pattern_away);
+  }
+  if (!like_for_like_desk.empty()) {
+    result["like_for_like_desk_edge"] = neighbourhoods(like_for_like_desk);
+    result["like_for_like_desk_edge_patterns"] = over_patterns(like_for_like_desk, pattern_desk);
+    if (real_desk.size() > 1) {
+      result["like_for_like_desk_edge_real_frames"] =
+          over_real_frames(like_for_like_desk, real_desk, pattern_desk);
+    }
   }
   return result;
 }

@@ -103,6 +103,11 @@ struct SensorCheckReport {
   // `excluded`, mapped to the rendered frames by ResampleDepthNearest). Empty without
   // RealView::others.
   std::vector<NeighbourhoodRow> like_for_like_away;
+  // The same along the desk's edge, when the view's table top ends in the picture (scene.table_x,
+  // table_y, table_yaw_deg): the top's pixels beside the floor's in the exact render grown by
+  // kNeighbourhoodRadiusPx, the object's and the other objects' neighbourhoods left out.
+  std::vector<NeighbourhoodRow> like_for_like_desk;
+  std::vector<NeighbourhoodStructure> pattern_desk, real_desk;
   // The structured-light view over RealView::patterns speckle patterns (the first is the one in
   // like_for_like's last row): per pattern, the neighbourhood near the object and away from the
   // other objects (the latter empty without RealView::others).

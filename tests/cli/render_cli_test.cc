@@ -220,6 +220,24 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
     }
   }
   EXPECT_THAT(r.output, HasSubstr("edge band across [px]"));
+  // Along the desk's edge (the committed view's desk, fitted from the real frame): the real frame
+  // and both modes see the floor beyond it, the IR shadow falls on it (runs of the shadow class in
+  // every row that crosses the edge, about 120) and the rendered edge lies where the real one is
+  // (the real band's width across within a factor 1.6 of structured light's; measured 8.6 and
+  // 11.9 px).
+  const nlohmann::json desk =
+      nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"))["like_for_like_desk_edge"];
+  ASSERT_EQ(desk.size(), 3u);
+  for (const auto& row : desk) {
+    EXPECT_GT(row["pixels"].get<double>(), 1000) << row.dump();
+    EXPECT_GT(row["shadow_runs"].get<int>(), 80) << row.dump();
+    EXPECT_GT(row["missing_share"].get<double>(), 0.1) << row.dump();
+  }
+  EXPECT_GT(desk[0]["shadow_band_across_px"].get<double>(),
+            desk[2]["shadow_band_across_px"].get<double>() / 1.6);
+  EXPECT_LT(desk[0]["shadow_band_across_px"].get<double>(),
+            desk[2]["shadow_band_across_px"].get<double>() * 1.6);
+  EXPECT_THAT(r.output, HasSubstr("along the desk's edge"));
   // The statistical sensor's holes are rules; the structured light's beside the object come from
   // the matching and so are more (measured 8.5 and 10.3 %, real 12.3 %).
   EXPECT_GT(like[2]["missing_share"].get<double>(), like[1]["missing_share"].get<double>());
@@ -229,11 +247,15 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // per-pattern ratios to the real frame (recomputed here).
   EXPECT_THAT(r.output, HasSubstr("8 patterns: SL/real"));
   const nlohmann::json json = nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"));
-  for (const char* table : {"like_for_like", "like_for_like_away"}) {
+  for (const char* table : {"like_for_like", "like_for_like_away", "like_for_like_desk_edge"}) {
     const nlohmann::json& over = json[std::string(table) + "_patterns"];
     ASSERT_EQ(over["patterns"].size(), 8u) << table;
     const nlohmann::json& real = json[table][0];
+    // Along the desk's edge some patterns leave no edge run (the band's width is then NaN, left
+    // out of the spread): its edge band is not recomputed here.
+    const bool desk_edge = std::string(table) == "like_for_like_desk_edge";
     for (const char* key : {"missing_share", "shadow_band_across_px", "edge_band_across_px"}) {
+      if (desk_edge && std::string(key) == "edge_band_across_px") continue;
       EXPECT_EQ(over["patterns"][0][key], json[table][2][key]) << table << " " << key;
       double sum = 0, sum2 = 0, low = 1e9;
       for (int k = 0; k < 8; ++k) {
@@ -253,7 +275,7 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // Over the real recording's frames 1-10 (by default as many as it has, up to 10): each frame's
   // statistics, and the ratio of the patterns' mean to the frames' mean (recomputed here).
   EXPECT_THAT(r.output, HasSubstr("over real frames 1-10 and 8 patterns"));
-  for (const char* table : {"like_for_like", "like_for_like_away"}) {
+  for (const char* table : {"like_for_like", "like_for_like_away", "like_for_like_desk_edge"}) {
     const nlohmann::json& frames = json[std::string(table) + "_real_frames"];
     ASSERT_EQ(frames["frames"].size(), 10u) << table;
     EXPECT_EQ(frames["frames"][0]["missing_share"], json[table][0]["missing_share"]);
@@ -270,7 +292,7 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   }
   // The view over time in structured light: from a still camera only the IR noise changes; moved
   // as the real camera moved, the pattern slides over the scene and the errors persist less at
-  // lag 4 (measured 0.653 and 0.641; the floor beyond the desk, whose windows at 1.4 m are
+  // lag 4 (measured 0.648 and 0.636; the floor beyond the desk, whose windows at 1.4 m are
   // mostly IR noise, new in every frame, thins the difference: 0.818 and 0.756 without it).
   const nlohmann::json& view_temporal = json["view_temporal_correlation"];
   ASSERT_EQ(view_temporal.size(), 2u);

@@ -95,6 +95,38 @@ TEST(TableTopSceneTest, SceneObjectsAreLoadedPlacedAndSeen) {
   EXPECT_GT(without[0].rendered, without[0].expected + 0.05);  // the table top, 10 cm lower
 }
 
+// The camera's roll turns the image about the viewing axis: the look-at point stays on it, the
+// image x axis (horizontal without roll) turns towards the image y by the roll.
+TEST(RenderConfigTest, CameraRollTurnsTheImageAboutTheViewingAxis) {
+  CameraPlacement camera;  // (0, -0.65, 0.55) looking at the origin
+  const Rigid3 level = camera.TableTCamera();
+  EXPECT_NEAR(level.rotation.toRotationMatrix().col(0).z(), 0.0, 1e-12);  // x horizontal
+  camera.roll_deg = 30;
+  const Rigid3 rolled = camera.TableTCamera();
+  const Eigen::Matrix3d r0 = level.rotation.toRotationMatrix();
+  const Eigen::Matrix3d r = rolled.rotation.toRotationMatrix();
+  EXPECT_LT((r.col(2) - r0.col(2)).norm(), 1e-12);  // the same viewing axis
+  const double c = std::cos(std::numbers::pi / 6), s = std::sin(std::numbers::pi / 6);
+  EXPECT_LT((r.col(0) - (c * r0.col(0) + s * r0.col(1))).norm(), 1e-12);
+  EXPECT_LT((r.col(1) - (-s * r0.col(0) + c * r0.col(1))).norm(), 1e-12);
+  // The origin, looked at, stays at the image centre; a point right of it in the level image is
+  // seen turned back by the roll (up, towards -y) in the rolled one.
+  const Eigen::Vector3d centre = rolled.Inverse() * Eigen::Vector3d::Zero();
+  EXPECT_NEAR(centre.x(), 0.0, 1e-12);
+  EXPECT_NEAR(centre.y(), 0.0, 1e-12);
+  const Eigen::Vector3d right = level * Eigen::Vector3d(0.1, 0, 0.85);
+  const Eigen::Vector3d seen = rolled.Inverse() * right;
+  EXPECT_NEAR(seen.x(), 0.1 * c, 1e-12);
+  EXPECT_NEAR(seen.y(), -0.1 * s, 1e-12);
+  camera.roll_deg = 200;
+  try {
+    camera.Validate("camera");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("camera.roll_deg: got 200"));
+  }
+}
+
 TEST(RenderConfigTest, ObjectMeshesAreRelativeToTheirConfigFile) {
   TempDir dir;
   std::filesystem::create_directories(dir / "views");

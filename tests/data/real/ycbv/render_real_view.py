@@ -21,15 +21,16 @@ defaults but the proxy's, a matte printed box) and table_T_proxy.tum:
                    ALBEDO and SPECULARITY are its IR material.
   --desk DEPTH_PNG  fits the desk the objects stand on from that real depth frame (YCB-Video's
                    16-bit depth, 1/10000 m, registered to the colour camera of --intrinsics): its
-                   front edge, where the table top's points meet the floor's (a line in the table
-                   frame, least squares over the image rows that cross it), and the floor's height
-                   below the top (median); writes scene.table_x, table_y, table_yaw_deg (a top of
+                   front edge, where the table top's pixels meet the floor's (per image row that
+                   crosses it, the top's last pixel; a line through them by total least squares;
+                   their depth below the top is the front face's thickness, so that the rendered
+                   edge falls on the same pixels), and the floor's height below the top (median); writes scene.table_x, table_y, table_yaw_deg (a top of
                    --desk-size whose front edge is that line), table_height, no tape (the real
                    scene has none: tape_thickness 0, a 0.1 m play area that stays on the desk) and
                    no wall (the floor beyond the desk, as in the real frame). Needs numpy.
 The camera is placed at the real camera's position in the table frame, looking at the point where
-the real optical axis meets the table; a look-at camera has no roll, so the real camera's roll
-about its axis (a few degrees) is not reproduced. Standard library only, but for --desk.
+the real optical axis meets the table, turned about its axis by the real camera's roll
+(camera.roll_deg; before 2026-11-30 the roll was left out). Standard library only, but for --desk.
 """
 import argparse
 import json
@@ -125,7 +126,9 @@ def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
     camera = np.stack([(u - cx) / fx * depth, (v - cy) / fy * depth, depth], -1)
     table = camera @ np.array(r_tc).T + np.array(t_tc)  # table_p = table_R_camera camera_p + t
     valid = depth > 0
-    on_top = valid & (np.abs(table[..., 2]) < 0.01)
+    # The top near its edge lies up to about 1.5 cm below the table fit of the frame's middle
+    # (the fit's tilt, or a desk that is not flat): a 5 cm slab, not the fit's own 1 cm.
+    on_top = valid & (np.abs(table[..., 2]) < 0.05)
     on_floor = valid & (table[..., 2] < -0.3)
     # Per image row, the table-top pixel nearest to the floor's pixels on its left or right,
     # where the row crosses the desk's edge (missing pixels between are allowed).
@@ -136,13 +139,20 @@ def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
         if len(floor_u) < 5 or len(top_u) < 5:
             continue
         if floor_u.max() < top_u.min():
-            edge.append(table[row, top_u.min(), :2])
+            edge.append(table[row, top_u.min()])
         elif top_u.max() < floor_u.min():
-            edge.append(table[row, top_u.max(), :2])
+            edge.append(table[row, top_u.max()])
     if len(edge) < 10:
         raise SystemExit(f"{depth_png}: {len(edge)} image rows cross the desk's edge; "
                          "expected at least 10 (a frame showing the floor beside the desk)")
+    # The pixels next to the floor see the desk's front face, whose lower edge is the last thing
+    # before the floor: they lie below the top (13.6 mm in frame 1 of video 0000). The rendered
+    # desk is given that thickness, so that its front face ends where the real one's pixels do
+    # and the two edges fall on the same pixels (with the default 3 cm the rendered edge fell up
+    # to 60 px below the real one).
     edge = np.array(edge)
+    thickness = max(0.005, -float(np.median(edge[:, 2])))
+    edge = edge[:, :2]
     # Total least squares: the edge's direction is the principal axis of its points.
     centre = edge.mean(0)
     direction = np.linalg.svd(edge - centre)[2][0]
@@ -155,12 +165,15 @@ def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
     x_axis = np.array([inward[1], -inward[0]])  # the top's +y is inward, its +x to the right
     middle = centre + 0.5 * depth_m * inward
     floor_z = float(np.median(table[on_floor][:, 2]))
+    print(f"desk: its edge pixels {1000 * thickness:.1f} mm below the top (median): the front "
+          "face's thickness")
     print(f"desk: front edge through ({centre[0]:.3f}, {centre[1]:.3f}) m along "
           f"({direction[0]:.3f}, {direction[1]:.3f}), {len(edge)} rows, rms "
           f"{1000 * np.sqrt((residual ** 2).mean()):.1f} mm; floor {-floor_z:.3f} m below the top")
     return {"table_x": float(middle[0]), "table_y": float(middle[1]),
             "table_yaw_deg": math.degrees(math.atan2(x_axis[1], x_axis[0])),
             "table_width": width, "table_depth": depth_m, "table_height": -floor_z,
+            "table_thickness": thickness,
             "tape_thickness": 0.0, "play_area_width": 0.1, "play_area_depth": 0.1,
             "backdrop": False}
 
@@ -198,6 +211,15 @@ def main():
         raise SystemExit(f"{args.track_folder}/track_summary.json: the camera does not look down at the table")
     along = -t_tc[2] / forward[2]
     look_at = [t_tc[i] + along * forward[i] for i in range(3)]
+    # The real camera's roll: its x axis against the look-at camera's (x horizontal, y down; the
+    # renderer's CameraPlacement::TableTCamera), turned towards y.
+    norm = math.hypot(forward[0], forward[1])
+    right = [forward[1] / norm, -forward[0] / norm, 0.0]  # forward x up, normalised
+    down = [forward[1] * right[2] - forward[2] * right[1], forward[2] * right[0] - forward[0] * right[2],
+            forward[0] * right[1] - forward[1] * right[0]]  # forward x right
+    x_axis = [r_tc[i][0] for i in range(3)]
+    roll = math.degrees(math.atan2(sum(x_axis[i] * down[i] for i in range(3)),
+                                   sum(x_axis[i] * right[i] for i in range(3))))
 
     def table_poses(track_folder):
         poses = []
@@ -250,7 +272,8 @@ def main():
     config = {
         "render": render,
         "camera": {"x": t_tc[0], "y": t_tc[1], "z": t_tc[2],
-                   "look_at_x": look_at[0], "look_at_y": look_at[1], "look_at_z": look_at[2]},
+                   "look_at_x": look_at[0], "look_at_y": look_at[1], "look_at_z": look_at[2],
+                   "roll_deg": roll},
         "scene": {"materials": {"proxy": {"ir_albedo": args.ir_albedo,
                                           "specularity": args.specularity}}},
     }
@@ -263,7 +286,7 @@ def main():
         json.dump(config, out, indent=2)
         out.write("\n")
     print(f"camera at {t_tc[0]:.3f} {t_tc[1]:.3f} {t_tc[2]:.3f} m, {along:.3f} m from the table "
-          f"along its axis; {len(rows)} frames -> {args.out}/{name}")
+          f"along its axis, roll {roll:.2f} deg; {len(rows)} frames -> {args.out}/{name}")
 
 
 if __name__ == "__main__":
