@@ -2,8 +2,14 @@
 
 #include <embree3/rtcore_config.h>
 
+#include "sim/embree_config.h"
+
 namespace mmh::sim {
 
-nlohmann::json LibraryVersions() { return {{"embree", RTC_VERSION_STRING}}; }
+nlohmann::json LibraryVersions() {
+  const char* config = EmbreeDeviceConfig();
+  return {{"embree", RTC_VERSION_STRING},
+          {"embree_device", config != nullptr ? config : "Embree's choice of kernels"}};
+}
 
 }  // namespace mmh::sim

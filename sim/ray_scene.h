@@ -73,10 +73,6 @@ class HitSink {
   virtual void Consume(const HitPacket& packet) = 0;
 };
 
-// The device config every RayScene gives Embree: "isa=avx2" where the CPU has AVX2 and FMA, so
-// that frames are the same bytes on every such machine; null (Embree's choice) elsewhere.
-const char* EmbreeDeviceConfig();
-
 class RayScene {
  public:
   // Creates the Embree device. Embree errors are reported through its error callback and thrown
