@@ -229,7 +229,8 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   const double half_d = 0.5 * table_depth;
   // Where a rectangle of the table frame leaves the table top: 1 if a corner lies beyond the top's
   // width, 2 beyond its depth (in the top's own frame, TableTTop), 0 if it lies on it.
-  const Rigid3 top_T_table = TableTTop().Inverse();
+  const Rigid3 table_T_top = TableTTop();
+  const Rigid3 top_T_table = table_T_top.Inverse();
   auto off_table = [&](double x0, double x1, double y0, double y1) {
     for (const double x : {x0, x1}) {
       for (const double y : {y0, y1}) {
@@ -283,7 +284,7 @@ void TableSceneOptions::Validate(const std::string& prefix) const {
   double far_edge = -10.0;
   for (const double x : {-half_w, half_w}) {
     for (const double y : {-half_d, half_d}) {
-      far_edge = std::max(far_edge, (TableTTop() * Eigen::Vector3d(x, y, 0.0)).y());
+      far_edge = std::max(far_edge, (table_T_top * Eigen::Vector3d(x, y, 0.0)).y());
     }
   }
   if (backdrop && (!std::isfinite(backdrop_y) || backdrop_y < far_edge || backdrop_y > 10.0)) {

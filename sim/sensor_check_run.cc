@@ -80,8 +80,6 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
   return report.rendered_frames[first];
 }
 
-// The real view rendered in both modes, and each frame's neighbourhood of the object beside the
-// real frame's (docs/sensor.md, "Like for like").
 // The like-for-like view over time in structured light (SensorCheckReport::view_temporal): frames
 // 0 .. the last lag from a still camera (only the IR noise changes), and with the real camera's
 // motion. The trajectory's object poses are the real camera_T_object carried into the table frame
@@ -147,6 +145,18 @@ std::vector<uint8_t> DeskEdgeMask(const std::vector<float>& depth_m,
   return edge;
 }
 
+// A mask (non-zero = in) on another pixel grid over the same rays: ResampleDepthNearest.
+std::vector<uint8_t> ResampleMask(const std::vector<uint8_t>& mask, const PinholeIntrinsics& from,
+                                  const PinholeIntrinsics& to) {
+  const std::vector<float> mapped =
+      ResampleDepthNearest(std::vector<float>(mask.begin(), mask.end()), from, to);
+  std::vector<uint8_t> out(mapped.size());
+  for (size_t p = 0; p < mapped.size(); ++p) out[p] = mapped[p] > 0.5f;
+  return out;
+}
+
+// The real view rendered in both modes, and each frame's neighbourhood of the object beside the
+// real frame's (docs/sensor.md, "Like for like").
 void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const RenderConfig& config = view.config;
   if (config.render.trajectory.empty()) {
@@ -213,10 +223,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
                     std::to_string(view.mask.size()) + " pixels (the frame's)");
     }
     real_away = GrowMask(view.others, view.width, view.height, real_radius);
-    const std::vector<float> away_m(real_away.begin(), real_away.end());
-    const std::vector<float> mapped = ResampleDepthNearest(away_m, view.intrinsics, intrinsics);
-    rendered_away.assign(mapped.size(), 0);
-    for (size_t p = 0; p < mapped.size(); ++p) rendered_away[p] = mapped[p] > 0.5f;
+    rendered_away = ResampleMask(real_away, view.intrinsics, intrinsics);
     report.like_for_like_away.push_back(
         {view.name, real_scale,
          AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius, {},
@@ -255,16 +262,9 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     }
   }
   if (desk) {
-    const std::vector<float> desk_m(rendered_desk.begin(), rendered_desk.end());
-    const std::vector<float> out_m(rendered_desk_out.begin(), rendered_desk_out.end());
-    const std::vector<float> real_desk_m =
-        ResampleDepthNearest(desk_m, intrinsics, view.intrinsics);
-    const std::vector<float> real_out_m = ResampleDepthNearest(out_m, intrinsics, view.intrinsics);
-    std::vector<uint8_t> real_desk(real_desk_m.size()), real_out(real_out_m.size());
-    for (size_t p = 0; p < real_desk.size(); ++p) {
-      real_desk[p] = real_desk_m[p] > 0.5f;
-      real_out[p] = real_out_m[p] > 0.5f;
-    }
+    const std::vector<uint8_t> real_desk = ResampleMask(rendered_desk, intrinsics, view.intrinsics);
+    const std::vector<uint8_t> real_out =
+        ResampleMask(rendered_desk_out, intrinsics, view.intrinsics);
     report.like_for_like_desk.push_back(
         {view.name, real_scale,
          AnalyseNeighbourhood(view.depth_m, view.width, view.height, real_desk, real_radius, {},
@@ -434,25 +434,23 @@ std::string SensorCheckReport::Format() const {
 
 std::string SensorCheckReport::FormatLikeForLike() const {
   char title[200];
-  std::snprintf(title, sizeof(title),
-                "\nlike for like: around the object (its mask grown by %d px), band widths in the "
-                "rendered sensor's pixels\n",
-                kNeighbourhoodRadiusPx);
-  std::string text = FormatNeighbourhoods(title, like_for_like, pattern_near, real_near);
-  if (!like_for_like_away.empty()) {
-    std::snprintf(title, sizeof(title),
-                  "\nlike for like, away from the other objects (the real frame's other labels "
-                  "grown by %d px, left out of both)\n",
-                  kNeighbourhoodRadiusPx);
-    text += FormatNeighbourhoods(title, like_for_like_away, pattern_away, real_away);
-  }
-  if (!like_for_like_desk.empty()) {
-    std::snprintf(title, sizeof(title),
-                  "\nlike for like, along the desk's edge (the table top's pixels beside the "
-                  "floor's grown by %d px, the objects' left out)\n",
-                  kNeighbourhoodRadiusPx);
-    text += FormatNeighbourhoods(title, like_for_like_desk, pattern_desk, real_desk);
-  }
+  std::string text;
+  auto add = [&](const std::vector<NeighbourhoodRow>& rows,
+                 const std::vector<NeighbourhoodStructure>& patterns,
+                 const std::vector<NeighbourhoodStructure>& real_frames, const char* format) {
+    if (rows.empty()) return;
+    std::snprintf(title, sizeof(title), format, kNeighbourhoodRadiusPx);
+    text += FormatNeighbourhoods(title, rows, patterns, real_frames);
+  };
+  add(like_for_like, pattern_near, real_near,
+      "\nlike for like: around the object (its mask grown by %d px), band widths in the "
+      "rendered sensor's pixels\n");
+  add(like_for_like_away, pattern_away, real_away,
+      "\nlike for like, away from the other objects (the real frame's other labels grown by %d "
+      "px, left out of both)\n");
+  add(like_for_like_desk, pattern_desk, real_desk,
+      "\nlike for like, along the desk's edge (the table top's pixels beside the floor's grown "
+      "by %d px, the objects' left out)\n");
   return text;
 }
 
