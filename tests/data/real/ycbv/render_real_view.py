@@ -126,8 +126,8 @@ def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
     camera = np.stack([(u - cx) / fx * depth, (v - cy) / fy * depth, depth], -1)
     table = camera @ np.array(r_tc).T + np.array(t_tc)  # table_p = table_R_camera camera_p + t
     valid = depth > 0
-    # The top near its edge lies up to about 1.5 cm below the table fit of the frame's middle
-    # (the fit's tilt, or a desk that is not flat): a 5 cm slab, not the fit's own 1 cm.
+    # The top's pixels by its edge see the desk's front face, down to about 1.5 cm below the top:
+    # a 5 cm slab, not the table fit's own 1 cm.
     on_top = valid & (np.abs(table[..., 2]) < 0.05)
     on_floor = valid & (table[..., 2] < -0.3)
     # Per image row, the table-top pixel nearest to the floor's pixels on its left or right,
