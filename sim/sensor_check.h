@@ -43,6 +43,9 @@ namespace mmh::sim {
 // NYU Depth V2 raw calibration: z [m] = 351.3 / (1092.5 - raw).
 inline constexpr double kNyuDepthNumerator = 351.3;  // [m raw units]
 inline constexpr double kNyuRawOffset = 1092.5;
+// NYU Depth V2's depth (IR) camera, whose image the raw frames are (the toolbox's camera_params.m).
+inline constexpr PinholeIntrinsics kNyuDepthIntrinsics{
+    640, 480, 582.62448167737955, 582.69103270988637, 313.04475870804731, 238.44389626620386};
 
 struct SensorCheckOptions {
   // Width of the depth bins of the tables [m].

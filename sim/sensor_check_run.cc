@@ -15,6 +15,31 @@
 namespace mmh::sim {
 namespace {
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// The missing runs beside depth steps of one sensor's frames, pooled for FitStepLaw.
+struct StepRuns {
+  std::vector<StepRun> shadow, edge;
+  int frames = 0;
+
+  void Add(const std::vector<float>& depth_m, int width, int height, double fx_px) {
+    CollectStepRuns(depth_m, width, height, fx_px, &shadow, &edge);
+    ++frames;
+  }
+  StepLawRow Fit(std::string name, double fx_px, double shadow_geometry_m = kNaN,
+                 double edge_geometry_m = kNaN) const {
+    return {std::move(name),    fx_px,           frames, shadow_geometry_m, edge_geometry_m,
+            FitStepLaw(shadow), FitStepLaw(edge)};
+  }
+  // A rendered sensor's: its geometry beside the fits.
+  StepLawRow Fit(std::string name, double fx_px, const KinectSensorOptions& sensor) const {
+    const double baseline = sensor.calibration.baseline;
+    return sensor.registered ? Fit(std::move(name), fx_px, baseline - sensor.ir_camera_offset,
+                                   sensor.ir_camera_offset)
+                             : Fit(std::move(name), fx_px, baseline, 0.0);
+  }
+};
+
 // The first frame's residual correlation with the frames kTemporalLags later.
 SensorCheckReport::TemporalRow TemporalStructure(const std::string& name,
                                                  const DepthSequence& sequence) {
@@ -47,6 +72,7 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
   const int last_lag = std::end(kTemporalLags)[-1];
   std::vector<std::vector<float>> sequence;  // frames 0 .. last_lag, for the temporal structure
   PinholeIntrinsics intrinsics;
+  StepRuns step_runs;
   for (int i = 0; i < std::max(frames, last_lag + 1); ++i) {
     const double t = i / config.sensor.frame_rate;
     table_top.SetFrame(config.motion.TableTProxy(t), config.motion.SliderValue(t));
@@ -63,6 +89,7 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
     if (i >= frames) continue;
     report.rendered_frames.push_back(
         ComputeSensorStatistics(name, depth_m, width, height, frame_options));
+    step_runs.Add(depth_m, width, height, frame.depth_intrinsics.fx);
     if (i > 0) continue;
     report.rendered_depth_m[structured ? 1 : 0] = depth_m;
     report.structure_names.push_back(name);
@@ -77,6 +104,7 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
   }
   report.temporal.push_back(TemporalStructure(
       name, {name, intrinsics.width, intrinsics.height, intrinsics, std::move(sequence)}));
+  report.step_laws.push_back(step_runs.Fit(name, intrinsics.fx, sensor_options));
   return report.rendered_frames[first];
 }
 
@@ -205,6 +233,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
       {view.name, real_scale,
        AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius)});
   report.real_near.push_back(report.like_for_like.back().structure);
+  StepRuns real_runs;
+  real_runs.Add(view.depth_m, view.width, view.height, view.intrinsics.fx);
   for (const RealView::Frame& frame : view.later_frames) {
     if (frame.depth_m.size() != view.depth_m.size() || frame.mask.size() != view.mask.size() ||
         frame.others.size() != view.others.size()) {
@@ -213,7 +243,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     }
     report.real_near.push_back(
         AnalyseNeighbourhood(frame.depth_m, view.width, view.height, frame.mask, real_radius));
+    real_runs.Add(frame.depth_m, view.width, view.height, view.intrinsics.fx);
   }
+  report.view_step_laws.push_back(
+      real_runs.Fit(view.name.substr(0, view.name.rfind(" frame ")), view.intrinsics.fx));
   // Near the other objects (grown as the neighbourhood is), on the real grid and on the rendered
   // one (the same rays).
   std::vector<uint8_t> real_away, rendered_away;
@@ -304,6 +337,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   report.native_view_depth_m[0] = on_native_grid(view.depth_m, view.intrinsics);
   scene.SetFrame(table_T_object, 0.0);
   std::vector<float> structured_depth_m;  // the structured-light frame, for the view over time
+  StepRuns pattern_runs;                  // structured light over the patterns
   for (const SensorMode mode : {SensorMode::kStatistical, SensorMode::kStructuredLight}) {
     KinectSensorOptions options = config.sensor;
     options.mode = mode;
@@ -328,7 +362,14 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
     report.native_view_depth_m[structured ? 2 : 1] = on_native_grid(depth_m, intrinsics);
-    if (structured) structured_depth_m = std::move(depth_m);
+    if (structured) {
+      pattern_runs.Add(depth_m, width, height, focal);
+      structured_depth_m = std::move(depth_m);
+    } else {
+      StepRuns runs;
+      runs.Add(depth_m, width, height, focal);
+      report.view_step_laws.push_back(runs.Fit("view, stat.", focal, options));
+    }
   }
   report.view_temporal = ViewOverTime(view.name, scene, config.sensor, poses,
                                       std::move(structured_depth_m), intrinsics);
@@ -353,7 +394,11 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
           depth_m, width, height, mask, kNeighbourhoodRadiusPx, {}, rendered_away));
     }
     if (desk) report.pattern_desk.push_back(analyse_desk(depth_m));
+    pattern_runs.Add(depth_m, width, height, focal);
   }
+  report.view_step_laws.push_back(pattern_runs.Fit(
+      "view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
+      focal, config.sensor));
 }
 
 }  // namespace
@@ -389,6 +434,13 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
                             options.calibration, options.noise),
       AnalyseErrorStructure(nyu_m, nyu.width, nyu.height, options.intrinsics,
                             options.calibration, options.noise)};
+  // TUM's frames are registered to the colour camera at the ROS default intrinsics (TUM's own
+  // calibration differs by 1-2 %); NYU's raw frame is the IR camera's.
+  StepRuns tum_runs, nyu_runs;
+  tum_runs.Add(report.tum_depth_m, tum.width, tum.height, options.intrinsics.fx);
+  nyu_runs.Add(nyu_m, nyu.width, nyu.height, kNyuDepthIntrinsics.fx);
+  report.step_laws = {tum_runs.Fit("TUM real", options.intrinsics.fx),
+                      nyu_runs.Fit("NYU real (raw, IR camera)", kNyuDepthIntrinsics.fx)};
 
   // Both sensor modes over the same scene.
   TableTopScene table_top(config, LoadProxyModel(config.render.proxy, config.render.proxy_scale));
@@ -428,6 +480,54 @@ std::string SensorCheckReport::Format() const {
   if (!view_temporal.empty()) {
     text += "\nthe real view over time: residual correlation with the first frame (as above)\n";
     add_rows(view_temporal);
+  }
+  return text + FormatStepLaws();
+}
+
+std::string SensorCheckReport::FormatStepLaws() const {
+  std::string text =
+      "\nstep law of the missing runs beside depth steps (sim/step_law.h): run = B x + c, "
+      "x = fx (1/z_near - 1/z_far) [px/m];\nB [cm] with its 95 % bootstrap interval, c in the "
+      "frames' pixels; model: the rendered sensor's own distances\n";
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-34s %7s %6s | %5s %9s %19s %6s %6s | %5s %9s %19s %6s %6s\n",
+                "frames", "fx", "frames", "runs", "x 10-90%", "shadow: B [cm]", "c", "model",
+                "runs", "x 10-90%", "edge: B [cm]", "c", "model");
+  text += line;
+  auto centimetres = [](double m) { return 100 * m; };
+  auto add = [&](const StepLawRow& row) {
+    std::snprintf(line, sizeof(line), "%-34s %7.1f %6d", row.name.c_str(), row.fx_px, row.frames);
+    text += line;
+    for (const auto& [law, model] : {std::pair{&row.shadow, row.shadow_geometry_m},
+                                     std::pair{&row.edge, row.edge_geometry_m}}) {
+      std::snprintf(line, sizeof(line), " | %5d %4.0f-%-4.0f %6.2f (%5.2f-%5.2f) %6.2f", law->runs,
+                    law->step_p10_px_per_m, law->step_p90_px_per_m, centimetres(law->slope_m),
+                    centimetres(law->slope_low_m), centimetres(law->slope_high_m),
+                    law->intercept_px);
+      text += line;
+      if (std::isfinite(model)) {
+        std::snprintf(line, sizeof(line), " %6.2f", centimetres(model));
+        text += line;
+      } else {
+        text += "      -";
+      }
+    }
+    text += "\n";
+  };
+  for (const StepLawRow& row : step_laws) add(row);
+  for (const StepLawRow& row : view_step_laws) add(row);
+  // What the real view's shadows say about its sensor, in the key that renders it.
+  if (view_step_laws.size() > 1 && std::isfinite(view_step_laws.front().shadow.slope_m)) {
+    const StepLawRow& real = view_step_laws.front();
+    const StepLawRow& model = view_step_laws.back();
+    std::snprintf(line, sizeof(line),
+                  "the real view's shadows put its projector %.2f cm (%.2f-%.2f) from its camera, "
+                  "the model's %.2f cm\n(sensor.ir_camera_offset = %.4f with the baseline kept "
+                  "renders that distance)\n",
+                  centimetres(real.shadow.slope_m), centimetres(real.shadow.slope_low_m),
+                  centimetres(real.shadow.slope_high_m), centimetres(model.shadow_geometry_m),
+                  model.shadow_geometry_m + model.edge_geometry_m - real.shadow.slope_m);
+    text += line;
   }
   return text;
 }
@@ -674,6 +774,22 @@ nlohmann::json SensorCheckReport::ToJson() const {
     result["like_for_like_away_real_frames"] =
         over_real_frames(like_for_like_away, real_away, pattern_away);
   }
+  auto step_law_rows = [](const std::vector<StepLawRow>& rows) {
+    auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); };
+    nlohmann::json out = nlohmann::json::array();
+    for (const StepLawRow& row : rows) {
+      out.push_back({{"frames", row.name},
+                     {"fx_px", row.fx_px},
+                     {"frame_count", row.frames},
+                     {"shadow", sim::ToJson(row.shadow)},
+                     {"edge", sim::ToJson(row.edge)},
+                     {"shadow_geometry_m", number(row.shadow_geometry_m)},
+                     {"edge_geometry_m", number(row.edge_geometry_m)}});
+    }
+    return out;
+  };
+  result["step_laws"] = step_law_rows(step_laws);
+  if (!view_step_laws.empty()) result["view_step_laws"] = step_law_rows(view_step_laws);
   if (!like_for_like_desk.empty()) {
     result["like_for_like_desk_edge"] = neighbourhoods(like_for_like_desk);
     result["like_for_like_desk_edge_patterns"] = over_patterns(like_for_like_desk, pattern_desk);

@@ -12,6 +12,7 @@
 #include "sim/error_structure.h"
 #include "sim/render_session.h"
 #include "sim/sensor_check.h"
+#include "sim/step_law.h"
 
 namespace mmh::sim {
 
@@ -62,6 +63,19 @@ inline constexpr int kNeighbourhoodRadiusPx = 10;
 // Frame lags of the temporal correlation (AnalyseTemporalCorrelation against the first frame).
 inline constexpr int kTemporalLags[] = {1, 4};
 
+// The step law (sim/step_law.h) of one sensor's frames, pooled: what geometry their missing
+// bands beside depth edges imply.
+struct StepLawRow {
+  std::string name;
+  double fx_px = 0;  // the focal length of the camera that delivers the frames
+  int frames = 0;
+  // A rendered sensor's own geometry [m]: the projector's distance from the camera that delivers
+  // the image (baseline - ir_camera_offset when registered, the baseline when not) and the IR
+  // camera's (ir_camera_offset, 0 when not registered); NaN for real frames.
+  double shadow_geometry_m = 0, edge_geometry_m = 0;
+  StepLaw shadow, edge;
+};
+
 struct SensorCheckReport {
   // TUM real, NYU real, SUN real, then the first frame of each rendered mode.
   std::vector<SensorStatistics> columns;
@@ -89,6 +103,12 @@ struct SensorCheckReport {
   // still camera, and moved as the real camera moved between the real frames (compare with the
   // real sequence's row in `temporal`).
   std::vector<TemporalRow> view_temporal;
+  // The step law of TUM, NYU (its raw frame is the IR camera's: kNyuDepthIntrinsics) and each
+  // rendered mode's frames of the demo walk (all `frames`).
+  std::vector<StepLawRow> step_laws;
+  // With a RealView: its real frames (the first and later_frames), the view rendered statistically
+  // and in structured light over its patterns.
+  std::vector<StepLawRow> view_step_laws;
   // Like for like (when a RealView is given): the real frame, then the view rendered in each mode
   // (statistical, structured light). pixel_scale turns the row's pixels into the rendered
   // sensor's (its focal length over the row's).
@@ -133,6 +153,7 @@ struct SensorCheckReport {
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
   std::string FormatLikeForLike() const;
+  std::string FormatStepLaws() const;
   static std::string FormatNeighbourhoods(
       const std::string& title, const std::vector<NeighbourhoodRow>& rows,
       const std::vector<NeighbourhoodStructure>& patterns = {},

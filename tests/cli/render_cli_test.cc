@@ -272,6 +272,45 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
       EXPECT_GT(spread["sd"].get<double>(), 0.0) << "the patterns differ";
     }
   }
+  // The step law (sim/step_law.h): the statistical sensor's shadows and occlusions are the
+  // geometry's, so its fit recovers the rendered sensor's own distances (projector 5 cm, IR camera
+  // 2.5 cm from the colour camera: measured 5.00 and 2.52 on the demo walk, 4.95 on the view,
+  // whose edge side has few large steps); every row pools its frames.
+  EXPECT_THAT(r.output, HasSubstr("step law of the missing runs beside depth steps"));
+  EXPECT_THAT(r.output, HasSubstr("the real view's shadows put its projector"));
+  const nlohmann::json& laws = json["step_laws"];
+  ASSERT_EQ(laws.size(), 4u);
+  EXPECT_EQ(laws[0]["frames"], "TUM real");
+  EXPECT_NEAR(laws[1]["fx_px"].get<double>(), 582.62, 0.01);  // NYU's IR camera
+  const nlohmann::json& statistical = laws[2];
+  ASSERT_EQ(statistical["frames"], "rendered stat.");
+  EXPECT_NEAR(statistical["shadow_geometry_m"].get<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(statistical["edge_geometry_m"].get<double>(), 0.025, 1e-12);
+  for (const char* side : {"shadow", "edge"}) {
+    const nlohmann::json& law = statistical[side];
+    const double geometry = statistical[std::string(side) + "_geometry_m"].get<double>();
+    EXPECT_GT(law["runs"].get<int>(), 100) << law.dump();
+    EXPECT_NEAR(law["slope_m"].get<double>(), geometry, 0.1 * geometry) << side;
+    EXPECT_LT(law["slope_low_m"].get<double>(), geometry) << side;
+    EXPECT_GT(law["slope_high_m"].get<double>(), geometry) << side;
+    EXPECT_NEAR(law["intercept_px"].get<double>(), 0.0, 1.0) << side;
+  }
+  const nlohmann::json& view_laws = json["view_step_laws"];
+  ASSERT_EQ(view_laws.size(), 3u);
+  EXPECT_EQ(view_laws[0]["frame_count"].get<int>(), 10);
+  EXPECT_EQ(view_laws[2]["frame_count"].get<int>(), 8);
+  EXPECT_NEAR(view_laws[1]["shadow"]["slope_m"].get<double>(), 0.05, 0.005);
+  for (const auto& row : view_laws) {
+    // The desk's edge gives the view's shadows steps up to ~650 px / m (1 / 0.55 - 1 / 1.4 m at
+    // 525 px; at 1066.8 px in the real frames): the slope is well determined in every row.
+    EXPECT_GT(row["shadow"]["step_p90_px_per_m"].get<double>(),
+              500 * row["fx_px"].get<double>() / 525);
+    EXPECT_LT(
+        row["shadow"]["slope_high_m"].get<double>() - row["shadow"]["slope_low_m"].get<double>(),
+        0.005)
+        << row.dump();
+  }
+
   // Over the real recording's frames 1-10 (by default as many as it has, up to 10): each frame's
   // statistics, and the ratio of the patterns' mean to the frames' mean (recomputed here).
   EXPECT_THAT(r.output, HasSubstr("over real frames 1-10 and 8 patterns"));
