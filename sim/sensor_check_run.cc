@@ -28,8 +28,19 @@ struct StepRuns {
   }
   StepLawRow Fit(std::string name, double fx_px, double shadow_geometry_m = kNaN,
                  double edge_geometry_m = kNaN) const {
-    return {std::move(name),    fx_px,           frames, shadow_geometry_m, edge_geometry_m,
-            FitStepLaw(shadow), FitStepLaw(edge)};
+    StepLawOptions all;
+    all.min_step_px_per_m *= fx_px / kStepLawFocalPx;
+    StepLawOptions small = all;
+    small.max_step_px_per_m = kSmallStepPxPerM * fx_px / kStepLawFocalPx;
+    return {std::move(name),
+            fx_px,
+            frames,
+            shadow_geometry_m,
+            edge_geometry_m,
+            FitStepLaw(shadow, all),
+            FitStepLaw(edge, all),
+            FitStepLaw(shadow, small),
+            FitStepLaw(edge, small)};
   }
   // A rendered sensor's: its geometry beside the fits.
   StepLawRow Fit(std::string name, double fx_px, const KinectSensorOptions& sensor) const {
@@ -493,13 +504,14 @@ std::string SensorCheckReport::FormatStepLaws() const {
   std::snprintf(line, sizeof(line), "%-34s %7s %6s | %5s %9s %19s %6s %6s | %5s %9s %19s %6s %6s\n",
                 "frames", "fx", "frames", "runs", "x 10-90%", "shadow: B [cm]", "c", "model",
                 "runs", "x 10-90%", "edge: B [cm]", "c", "model");
-  text += line;
+  const std::string header = line;
   auto centimetres = [](double m) { return 100 * m; };
-  auto add = [&](const StepLawRow& row) {
+  auto add = [&](const StepLawRow& row, bool small) {
     std::snprintf(line, sizeof(line), "%-34s %7.1f %6d", row.name.c_str(), row.fx_px, row.frames);
     text += line;
-    for (const auto& [law, model] : {std::pair{&row.shadow, row.shadow_geometry_m},
-                                     std::pair{&row.edge, row.edge_geometry_m}}) {
+    for (const auto& [law, model] :
+         {std::pair{small ? &row.shadow_small : &row.shadow, row.shadow_geometry_m},
+          std::pair{small ? &row.edge_small : &row.edge, row.edge_geometry_m}}) {
       std::snprintf(line, sizeof(line), " | %5d %4.0f-%-4.0f %6.2f (%5.2f-%5.2f) %6.2f", law->runs,
                     law->step_p10_px_per_m, law->step_p90_px_per_m, centimetres(law->slope_m),
                     centimetres(law->slope_low_m), centimetres(law->slope_high_m),
@@ -514,20 +526,17 @@ std::string SensorCheckReport::FormatStepLaws() const {
     }
     text += "\n";
   };
-  for (const StepLawRow& row : step_laws) add(row);
-  for (const StepLawRow& row : view_step_laws) add(row);
-  // What the real view's shadows say about its sensor, in the key that renders it.
-  if (view_step_laws.size() > 1 && std::isfinite(view_step_laws.front().shadow.slope_m)) {
-    const StepLawRow& real = view_step_laws.front();
-    const StepLawRow& model = view_step_laws.back();
-    std::snprintf(line, sizeof(line),
-                  "the real view's shadows put its projector %.2f cm (%.2f-%.2f) from its camera, "
-                  "the model's %.2f cm\n(sensor.ir_camera_offset = %.4f with the baseline kept "
-                  "renders that distance)\n",
-                  centimetres(real.shadow.slope_m), centimetres(real.shadow.slope_low_m),
-                  centimetres(real.shadow.slope_high_m), centimetres(model.shadow_geometry_m),
-                  model.shadow_geometry_m + model.edge_geometry_m - real.shadow.slope_m);
-    text += line;
+  for (const bool small : {false, true}) {
+    if (small) {
+      std::snprintf(line, sizeof(line),
+                    "small steps only (x up to %.0f px/m at %.0f px: the objects on a table top)\n",
+                    kSmallStepPxPerM, kStepLawFocalPx);
+    } else {
+      std::snprintf(line, sizeof(line), "all steps (x from 40 px/m at %.0f px)\n", kStepLawFocalPx);
+    }
+    text += line + header;
+    for (const StepLawRow& row : step_laws) add(row, small);
+    for (const StepLawRow& row : view_step_laws) add(row, small);
   }
   return text;
 }
@@ -783,6 +792,8 @@ nlohmann::json SensorCheckReport::ToJson() const {
                      {"frame_count", row.frames},
                      {"shadow", sim::ToJson(row.shadow)},
                      {"edge", sim::ToJson(row.edge)},
+                     {"shadow_small_steps", sim::ToJson(row.shadow_small)},
+                     {"edge_small_steps", sim::ToJson(row.edge_small)},
                      {"shadow_geometry_m", number(row.shadow_geometry_m)},
                      {"edge_geometry_m", number(row.edge_geometry_m)}});
     }

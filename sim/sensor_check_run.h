@@ -73,8 +73,16 @@ struct StepLawRow {
   // the image (baseline - ir_camera_offset when registered, the baseline when not) and the IR
   // camera's (ir_camera_offset, 0 when not registered); NaN for real frames.
   double shadow_geometry_m = 0, edge_geometry_m = 0;
-  StepLaw shadow, edge;
+  // Over all steps, and over the small ones alone (kSmallStepPxPerM).
+  StepLaw shadow, edge, shadow_small, edge_small;
 };
+
+// The step laws' ranges of x at 525 px (scaled with each row's focal length, so that every row
+// cuts at the same inverse-depth step): from 40 px / m (2 px of shadow at 5 cm), and the small
+// steps up to 200 px / m (10 px at 5 cm; the objects on a table top, where the desk's edge gives
+// ~600).
+inline constexpr double kStepLawFocalPx = 525;
+inline constexpr double kSmallStepPxPerM = 200;
 
 struct SensorCheckReport {
   // TUM real, NYU real, SUN real, then the first frame of each rendered mode.

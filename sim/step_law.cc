@@ -80,6 +80,10 @@ void StepLawOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".min_step_px_per_m", FormatNumber(min_step_px_per_m),
                   "a finite step of 0 px / m or more");
   }
+  if (!(max_step_px_per_m > min_step_px_per_m)) {
+    ThrowBadValue(prefix + ".max_step_px_per_m", FormatNumber(max_step_px_per_m),
+                  "above min_step_px_per_m (" + FormatNumber(min_step_px_per_m) + ")");
+  }
   if (min_runs < 2) {
     ThrowBadValue(prefix + ".min_runs", std::to_string(min_runs), "2 or more (a line)");
   }
@@ -140,7 +144,10 @@ StepLaw FitStepLaw(std::span<const StepRun> runs, const StepLawOptions& options)
                     FormatNumber(r.step_px_per_m) + " px / m, " + FormatNumber(r.length_px) + " px",
                     "finite values");
     }
-    if (r.step_px_per_m >= options.min_step_px_per_m) kept.push_back(r);
+    if (r.step_px_per_m >= options.min_step_px_per_m &&
+        r.step_px_per_m <= options.max_step_px_per_m) {
+      kept.push_back(r);
+    }
   }
   StepLaw law;
   law.runs = static_cast<int>(kept.size());

@@ -16,12 +16,16 @@
 //
 // Runs are ClassifyMissing's shadow runs (far side on the left) and edge runs (far side on the
 // right), whose valid neighbours give z_far and z_near. Runs with x < min_step_px_per_m are left
-// out: beside a small step the window's failures are the whole run. The fit is least absolute
-// deviations (the runs' errors are not Gaussian: a hole beside a shadow lengthens it, a third
-// surface ends it early); its slope's confidence interval is the percentile bootstrap over runs.
+// out: beside a small step the window's failures are the whole run. A sensor's runs need not
+// follow one line over all steps (a matcher may fill part of a wide shadow, or lose a constant
+// beside a narrow one): fit ranges of steps apart (max_step_px_per_m) and compare like ranges. The
+// fit is least absolute deviations (the runs' errors are not Gaussian: a hole beside a shadow
+// lengthens it, a third surface ends it early); its slope's confidence interval is the percentile
+// bootstrap over runs.
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -38,8 +42,10 @@ struct StepRun {
 };
 
 struct StepLawOptions {
-  // Runs beside steps with x below this are left out (40 px / m: 2 px of shadow at 5 cm).
+  // Runs beside steps with x outside [min, max] are left out (40 px / m: 2 px of shadow at 5 cm;
+  // max: a range of steps on its own, e.g. the small ones, whose runs may follow another line).
   double min_step_px_per_m = 40.0;
+  double max_step_px_per_m = std::numeric_limits<double>::infinity();
   int min_runs = 10;  // fewer: no fit (NaN)
   // Bootstrap resamples for the slope's interval (0: none, the interval is NaN).
   int bootstrap_samples = 200;
@@ -67,9 +73,10 @@ void CollectStepRuns(const std::vector<float>& depth_m, int width, int height, d
                      std::vector<StepRun>* shadow, std::vector<StepRun>* edge,
                      const ErrorStructureOptions& options = {});
 
-// The least-absolute-deviations line run = slope x + intercept through `runs` (those with
-// x >= min_step_px_per_m), with the slope's bootstrap interval. Runs from several frames of one
-// sensor may be pooled when their focal lengths are the same (else scale the lengths).
+// The least-absolute-deviations line run = slope x + intercept through `runs` (those with x in
+// [min_step_px_per_m, max_step_px_per_m]), with the slope's bootstrap interval. Runs from several
+// frames of one sensor may be pooled when their focal lengths are the same (else scale the
+// lengths).
 StepLaw FitStepLaw(std::span<const StepRun> runs, const StepLawOptions& options = {});
 
 // The sum of |length - slope x - intercept| over `runs`: the objective FitStepLaw minimises.

@@ -122,6 +122,25 @@ TEST(StepLaw, SmallStepsAndTooFewRunsAreLeftOut) {
   EXPECT_EQ(FitStepLaw(std::vector<StepRun>{}).runs, 0);
 }
 
+TEST(StepLaw, ARangeOfStepsIsFittedOnItsOwn) {
+  // Small steps on one line, large ones on another (a matcher that fills part of wide shadows):
+  // the whole range follows neither; each range alone gives its own.
+  std::vector<StepRun> runs = LineRuns(300, 0.055, -0.6, 0.3, 0.0, 21, 40, 200);
+  const std::vector<StepRun> large = LineRuns(300, 0.04, -2.0, 0.3, 0.0, 22, 450, 700);
+  runs.insert(runs.end(), large.begin(), large.end());
+  StepLawOptions small;
+  small.max_step_px_per_m = 200;
+  const StepLaw law = FitStepLaw(runs, small);
+  EXPECT_EQ(law.runs, 300);
+  EXPECT_NEAR(law.slope_m, 0.055, 0.002);
+  EXPECT_NEAR(law.intercept_px, -0.6, 0.3);
+  EXPECT_LE(law.step_p90_px_per_m, 200);
+  StepLawOptions wide;
+  wide.min_step_px_per_m = 400;
+  EXPECT_NEAR(FitStepLaw(runs, wide).slope_m, 0.04, 0.002);
+  EXPECT_GT(std::abs(FitStepLaw(runs).slope_m - 0.055), 0.003);
+}
+
 TEST(StepLaw, ShadowAndEdgeRunsCarryTheirStep) {
   // A wall at 2 m; in each row a near board at z_near over columns [200, 260), a shadow of 7 px
   // left of it (the far side on the left) and an occlusion of 3 px right of it; a hole inside the
@@ -195,6 +214,9 @@ TEST(StepLaw, BadOptionsNameTheKey) {
   o = {};
   o.bootstrap_samples = -1;
   EXPECT_NE(message(o).find("step_law.bootstrap_samples"), std::string::npos);
+  o = {};
+  o.max_step_px_per_m = o.min_step_px_per_m;
+  EXPECT_NE(message(o).find("step_law.max_step_px_per_m"), std::string::npos);
   o = {};
   o.min_step_px_per_m = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(message(o).find("step_law.min_step_px_per_m"), std::string::npos);
