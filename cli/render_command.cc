@@ -57,10 +57,14 @@ void RunRender(const CommonFlags& common, const std::vector<std::string>& argv) 
   }
 }
 
+// Frames of --kinect-sequence read at most.
+constexpr int kKinectSequenceFrames = 10;
+
 struct SensorCheckArgs {
   CommonFlags common;
   std::string data;
   std::string sequence;
+  std::string kinect_sequence;  // real Kinect v1 frames for the step law
   // Like for like (docs/sensor.md): the sequence's first frame beside the same view rendered.
   std::string view, view_model, view_trajectory, view_label;
   int view_object = 8;
@@ -83,6 +87,10 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   if (!args.sequence.empty()) {
     sequence = pipeline::ReadDepthSequence(args.sequence, std::end(sim::kTemporalLags)[-1] + 1);
   }
+  std::optional<sim::DepthSequence> kinect;
+  if (!args.kinect_sequence.empty()) {
+    kinect = pipeline::ReadDepthSequence(args.kinect_sequence, -kKinectSequenceFrames);
+  }
   std::optional<sim::RealView> view;
   if (!args.view.empty()) {
     if (args.sequence.empty()) {
@@ -99,7 +107,7 @@ void RunSensorCheck(const SensorCheckArgs& args, const std::vector<std::string>&
   }
   const sim::SensorCheckReport report =
       sim::RunSensorCheck(args.data, render, args.frames, sequence ? &*sequence : nullptr,
-                          view ? &*view : nullptr);
+                          view ? &*view : nullptr, kinect ? &*kinect : nullptr);
   std::cout << report.Format();
   if (!args.common.out_dir.empty()) {
     const std::filesystem::path out = args.common.out_dir;
@@ -140,6 +148,16 @@ void AddSensorCheckCommand(CLI::App& app, const std::vector<std::string>& argv) 
   cmd->add_option("--sequence", args->sequence,
                   "Real recording (BOP, YCB-Video or TUM folder) of a nearly static view: the "
                   "temporal structure of its errors; empty: none")
+      ->capture_default_str();
+  // Two frames of TUM's freiburg1_xyz (Kinect v1; tests/data/real/tum/.../PROVENANCE.md): depth
+  // steps of many sizes for the step law.
+  args->kinect_sequence =
+      std::string(MMH_SOURCE_DIR) + "/tests/data/real/tum/rgbd_dataset_freiburg1_xyz";
+  cmd->add_option("--kinect-sequence", args->kinect_sequence,
+                  "Real Kinect v1 recording (TUM, BOP or YCB-Video folder; its first " +
+                      std::to_string(kKinectSequenceFrames) +
+                      " frames at most) whose missing bands beside depth steps the step law "
+                      "compares with the model's; empty: none")
       ->capture_default_str();
   // The same view rendered (tests/data/real/ycbv/views, render_real_view.py): the gelatin box of
   // video 0000 where its truth puts it, seen from where the real camera stood.

@@ -8,40 +8,66 @@
 #include "core/config.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/rgbd_folder.h"
 #include "core/rgbd_frame.h"
 #include "track/recording.h"
 
 namespace mmh::pipeline {
 
+namespace {
+
+// The frames' depth in metres into `sequence`, checking that every frame has the first's size.
+void AddDepth(const std::filesystem::path& folder, int k, const RgbdFrame& frame,
+              sim::DepthSequence& sequence) {
+  if (k == 0) {
+    sequence.intrinsics = frame.depth_intrinsics;
+    sequence.width = frame.depth_intrinsics.width;
+    sequence.height = frame.depth_intrinsics.height;
+  } else if (frame.depth_intrinsics.width != sequence.width ||
+             frame.depth_intrinsics.height != sequence.height) {
+    ThrowBadValue(folder.string() + ": frame " + std::to_string(k) + " size",
+                  std::to_string(frame.depth_intrinsics.width) + "x" +
+                      std::to_string(frame.depth_intrinsics.height),
+                  "the first frame's " + std::to_string(sequence.width) + "x" +
+                      std::to_string(sequence.height));
+  }
+  std::vector<float> depth_m(frame.depth.size());
+  for (size_t i = 0; i < depth_m.size(); ++i) {
+    depth_m[i] = static_cast<float>(frame.depth[i] * frame.depth_scale);
+  }
+  sequence.depth_m.push_back(std::move(depth_m));
+}
+
+void CheckFrameCount(const std::filesystem::path& folder, int available, int& frames) {
+  if (frames < 1) frames = std::min(-frames, available);
+  if (available < frames || frames < 1) {
+    ThrowBadValue(folder.string() + ": frames", std::to_string(available),
+                  "at least " + std::to_string(std::max(frames, 1)) + " frames");
+  }
+}
+
+}  // namespace
+
 sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int frames) {
-  track::RecordingFrameSource source(folder);
+  if (!std::filesystem::is_directory(folder)) {
+    ThrowBadValue(folder.string(), "no such folder",
+                  "a BOP scene, a YCB-Video folder or a TUM RGB-D folder (depth.txt)");
+  }
   sim::DepthSequence sequence;
+  // A TUM RGB-D folder (depth.txt; its intrinsics from camera.json or the freiburg name).
+  if (std::filesystem::exists(folder / "depth.txt")) {
+    const RgbdFolderReader reader(folder);
+    sequence.name = "real TUM " + folder.filename().string();
+    CheckFrameCount(folder, reader.size(), frames);
+    for (int k = 0; k < frames; ++k) AddDepth(folder, k, reader.Read(k), sequence);
+    return sequence;
+  }
+  track::RecordingFrameSource source(folder);
   sequence.name = std::string("real ") + track::RecordingLayoutName(source.layout()) + " " +
                   folder.filename().string();
-  if (source.size() < frames) {
-    ThrowBadValue(folder.string() + ": frames", std::to_string(source.size()),
-                  "at least " + std::to_string(frames) + " frames");
-  }
+  CheckFrameCount(folder, source.size(), frames);
   RgbdFrame frame;
-  for (int k = 0; k < frames && source.Next(&frame); ++k) {
-    if (k == 0) {
-      sequence.intrinsics = frame.depth_intrinsics;
-      sequence.width = frame.depth_intrinsics.width;
-      sequence.height = frame.depth_intrinsics.height;
-    } else if (frame.depth_intrinsics.width != sequence.width ||
-               frame.depth_intrinsics.height != sequence.height) {
-      ThrowBadValue(folder.string() + ": frame " + std::to_string(k) + " size",
-                    std::to_string(frame.depth_intrinsics.width) + "x" +
-                        std::to_string(frame.depth_intrinsics.height),
-                    "the first frame's " + std::to_string(sequence.width) + "x" +
-                        std::to_string(sequence.height));
-    }
-    std::vector<float> depth_m(frame.depth.size());
-    for (size_t i = 0; i < depth_m.size(); ++i) {
-      depth_m[i] = static_cast<float>(frame.depth[i] * frame.depth_scale);
-    }
-    sequence.depth_m.push_back(std::move(depth_m));
-  }
+  for (int k = 0; k < frames && source.Next(&frame); ++k) AddDepth(folder, k, frame, sequence);
   return sequence;
 }
 

@@ -10,8 +10,10 @@
 
 namespace mmh::pipeline {
 
-// The first `frames` frames of the recording in `folder` (track::RecordingFrameSource), depth in
-// metres. InputError naming the folder when it has fewer frames or they differ in size.
+// The first `frames` frames of the recording in `folder` (track::RecordingFrameSource; a TUM RGB-D
+// folder, with depth.txt, through RgbdFolderReader), depth in metres; frames < 1: as many as it
+// has, at most -frames. InputError naming the folder when it
+// has fewer frames (none) or they differ in size.
 sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int frames);
 
 // A real frame and the same view rendered (sim::RealView): the first frame of the recording in

@@ -416,8 +416,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
 
 SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
                                  const RenderConfig& config, int frames,
-                                 const DepthSequence* real_sequence,
-                                 const RealView* real_view) {
+                                 const DepthSequence* real_sequence, const RealView* real_view,
+                                 const DepthSequence* kinect_sequence) {
   SensorCheckReport report;
   if (real_view != nullptr) CompareLikeForLike(*real_view, report);
   if (real_sequence != nullptr) {
@@ -452,6 +452,14 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
   nyu_runs.Add(nyu_m, nyu.width, nyu.height, kNyuDepthIntrinsics.fx);
   report.step_laws = {tum_runs.Fit("TUM real", options.intrinsics.fx),
                       nyu_runs.Fit("NYU real (raw, IR camera)", kNyuDepthIntrinsics.fx)};
+  if (kinect_sequence != nullptr) {
+    StepRuns runs;
+    for (const std::vector<float>& depth_m : kinect_sequence->depth_m) {
+      runs.Add(depth_m, kinect_sequence->width, kinect_sequence->height,
+               kinect_sequence->intrinsics.fx);
+    }
+    report.step_laws.push_back(runs.Fit(kinect_sequence->name, kinect_sequence->intrinsics.fx));
+  }
 
   // Both sensor modes over the same scene.
   TableTopScene table_top(config, LoadProxyModel(config.render.proxy, config.render.proxy_scale));
@@ -499,23 +507,27 @@ std::string SensorCheckReport::FormatStepLaws() const {
   std::string text =
       "\nstep law of the missing runs beside depth steps (sim/step_law.h): run = B x + c, "
       "x = fx (1/z_near - 1/z_far) [px/m];\nB [cm] with its 95 % bootstrap interval, c in the "
-      "frames' pixels; model: the rendered sensor's own distances\n";
+      "frames' pixels; @100: the run beside a step of 100 px/m at 525 px (5 px of shadow at 5 "
+      "cm), in pixels at 525 px; model: the rendered sensor's own distances\n";
   char line[256];
-  std::snprintf(line, sizeof(line), "%-34s %7s %6s | %5s %9s %19s %6s %6s | %5s %9s %19s %6s %6s\n",
-                "frames", "fx", "frames", "runs", "x 10-90%", "shadow: B [cm]", "c", "model",
-                "runs", "x 10-90%", "edge: B [cm]", "c", "model");
+  std::snprintf(line, sizeof(line),
+                "%-38s %7s %6s | %5s %9s %19s %6s %6s %6s | %5s %9s %19s %6s %6s %6s\n", "frames",
+                "fx", "frames", "runs", "x 10-90%", "shadow: B [cm]", "c", "@100", "model", "runs",
+                "x 10-90%", "edge: B [cm]", "c", "@100", "model");
   const std::string header = line;
   auto centimetres = [](double m) { return 100 * m; };
   auto add = [&](const StepLawRow& row, bool small) {
-    std::snprintf(line, sizeof(line), "%-34s %7.1f %6d", row.name.c_str(), row.fx_px, row.frames);
+    std::snprintf(line, sizeof(line), "%-38s %7.1f %6d", row.name.c_str(), row.fx_px, row.frames);
     text += line;
     for (const auto& [law, model] :
          {std::pair{small ? &row.shadow_small : &row.shadow, row.shadow_geometry_m},
           std::pair{small ? &row.edge_small : &row.edge, row.edge_geometry_m}}) {
-      std::snprintf(line, sizeof(line), " | %5d %4.0f-%-4.0f %6.2f (%5.2f-%5.2f) %6.2f", law->runs,
-                    law->step_p10_px_per_m, law->step_p90_px_per_m, centimetres(law->slope_m),
-                    centimetres(law->slope_low_m), centimetres(law->slope_high_m),
-                    law->intercept_px);
+      // The fitted run beside a step of 100 px / m at 525 px, in pixels at 525 px.
+      const double at_100 = law->slope_m * 100 + law->intercept_px * kStepLawFocalPx / row.fx_px;
+      std::snprintf(line, sizeof(line), " | %5d %4.0f-%-4.0f %6.2f (%5.2f-%5.2f) %6.2f %6.2f",
+                    law->runs, law->step_p10_px_per_m, law->step_p90_px_per_m,
+                    centimetres(law->slope_m), centimetres(law->slope_low_m),
+                    centimetres(law->slope_high_m), law->intercept_px, at_100);
       text += line;
       if (std::isfinite(model)) {
         std::snprintf(line, sizeof(line), " %6.2f", centimetres(model));

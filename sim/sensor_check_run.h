@@ -111,8 +111,9 @@ struct SensorCheckReport {
   // still camera, and moved as the real camera moved between the real frames (compare with the
   // real sequence's row in `temporal`).
   std::vector<TemporalRow> view_temporal;
-  // The step law of TUM, NYU (its raw frame is the IR camera's: kNyuDepthIntrinsics) and each
-  // rendered mode's frames of the demo walk (all `frames`).
+  // The step law of TUM, NYU (its raw frame is the IR camera's: kNyuDepthIntrinsics), the
+  // kinect_sequence's frames (when given) and each rendered mode's frames of the demo walk (all
+  // `frames`).
   std::vector<StepLawRow> step_laws;
   // With a RealView: its real frames (the first and later_frames), the view rendered statistically
   // and in structured light over its patterns.
@@ -175,11 +176,13 @@ struct SensorCheckReport {
 // both sensor modes (at least kTemporalLags.back() + 1 for the temporal structure, which the
 // statistics of frames beyond `frames` do not enter). `real_sequence`: a real recording's first
 // frames for the temporal structure (nullptr: none). `real_view`: a real frame and its view to
-// compare like for like (nullptr: none).
+// compare like for like (nullptr: none). `kinect_sequence`: more real Kinect v1 frames for the
+// step law (nullptr: none).
 SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
                                  const RenderConfig& config, int frames,
                                  const DepthSequence* real_sequence = nullptr,
-                                 const RealView* real_view = nullptr);
+                                 const RealView* real_view = nullptr,
+                                 const DepthSequence* kinect_sequence = nullptr);
 
 // Writes sensor_check.json and, when the frames have the same size, sensor_check.png (TUM,
 // statistical, structured light side by side) into `out`; with a like-for-like comparison also

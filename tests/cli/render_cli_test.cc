@@ -279,10 +279,15 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   EXPECT_THAT(r.output, HasSubstr("step law of the missing runs beside depth steps"));
   EXPECT_THAT(r.output, HasSubstr("small steps only"));
   const nlohmann::json& laws = json["step_laws"];
-  ASSERT_EQ(laws.size(), 4u);
+  ASSERT_EQ(laws.size(), 5u);
   EXPECT_EQ(laws[0]["frames"], "TUM real");
   EXPECT_NEAR(laws[1]["fx_px"].get<double>(), 582.62, 0.01);  // NYU's IR camera
-  const nlohmann::json& statistical = laws[2];
+  // --kinect-sequence: TUM's freiburg1_xyz, its two committed frames at fr1's focal length.
+  EXPECT_EQ(laws[2]["frames"], "real TUM rgbd_dataset_freiburg1_xyz");
+  EXPECT_EQ(laws[2]["frame_count"].get<int>(), 2);
+  EXPECT_EQ(laws[2]["fx_px"].get<double>(), 517.3);
+  EXPECT_GT(laws[2]["shadow"]["runs"].get<int>(), 500);
+  const nlohmann::json& statistical = laws[3];
   ASSERT_EQ(statistical["frames"], "rendered stat.");
   EXPECT_NEAR(statistical["shadow_geometry_m"].get<double>(), 0.05, 1e-12);
   EXPECT_NEAR(statistical["edge_geometry_m"].get<double>(), 0.025, 1e-12);
