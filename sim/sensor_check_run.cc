@@ -459,6 +459,11 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
                kinect_sequence->intrinsics.fx);
     }
     report.step_laws.push_back(runs.Fit(kinect_sequence->name, kinect_sequence->intrinsics.fx));
+    // Its first frame's error structure beside TUM's and NYU's (at its own intrinsics).
+    report.structure_names.push_back(kinect_sequence->name);
+    report.structures.push_back(AnalyseErrorStructure(
+        kinect_sequence->depth_m.front(), kinect_sequence->width, kinect_sequence->height,
+        kinect_sequence->intrinsics, options.calibration, options.noise));
   }
 
   // Both sensor modes over the same scene.
@@ -471,8 +476,9 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
 
 std::string SensorCheckReport::Format() const {
   std::string text = FormatSensorTable(columns) + "\n" +
-                     FormatRealismTable(structure_names, structures, 0, {2, 3}) + "\n" +
-                     "structured light, first frame: " + cause_table;
+                     FormatRealismTable(structure_names, structures, 0,
+                                        {structures.size() - 2, structures.size() - 1}) +
+                     "\n" + "structured light, first frame: " + cause_table;
   // The temporal structure: one row per sequence, rho and the windows at each lag.
   text += "\nresidual correlation with the first frame (planar windows kept in both)\n";
   char line[160];

@@ -89,7 +89,8 @@ struct SensorCheckReport {
   std::vector<SensorStatistics> columns;
   // Every rendered frame: the statistical mode's, then structured light's.
   std::vector<SensorStatistics> rendered_frames;
-  // The error structure of TUM, NYU and each mode's first frame, by name.
+  // The error structure of TUM, NYU, the kinect_sequence's first frame (when given) and each
+  // mode's first frame, by name.
   std::vector<std::string> structure_names;
   std::vector<ErrorStructure> structures;
   // Structured light's first frame: missing pixels by the sensor's cause against the causes the

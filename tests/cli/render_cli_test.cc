@@ -287,6 +287,10 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   EXPECT_EQ(laws[2]["frame_count"].get<int>(), 2);
   EXPECT_EQ(laws[2]["fx_px"].get<double>(), 517.3);
   EXPECT_GT(laws[2]["shadow"]["runs"].get<int>(), 500);
+  // ... and its first frame's error structure beside TUM's and NYU's, at fr1's intrinsics.
+  const nlohmann::json& fr1 = json["error_structure"]["real TUM rgbd_dataset_freiburg1_xyz"];
+  EXPECT_GT(fr1["patches"].get<int>(), 100) << fr1.dump();
+  EXPECT_THAT(r.output, HasSubstr("real TUM rgbd_dataset_freiburg1_xyz"));
   const nlohmann::json& statistical = laws[3];
   ASSERT_EQ(statistical["frames"], "rendered stat.");
   EXPECT_NEAR(statistical["shadow_geometry_m"].get<double>(), 0.05, 1e-12);
