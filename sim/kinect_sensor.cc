@@ -76,7 +76,7 @@ struct KinectSensor::Impl {
     std::vector<float> disparity;      // IR disparity f b / z [px]; 0 where nothing was hit
     std::vector<float> cos_incidence;  // in [0, 1]; 0 where nothing was hit
     std::vector<uint8_t> color;        // shaded sRGB before noise (views that deliver colour)
-    std::vector<uint8_t> occluded;     // hidden from an occluder source
+    std::vector<uint8_t> occluded;     // hidden from occluder sources: their bits, 0 = seen
     // The hit's SurfaceMaterial (structured-light mode only): ir_albedo (1 - specularity) and
     // specularity; 0 where nothing was hit.
     std::vector<float> ir_diffuse, ir_specular;
@@ -99,8 +99,10 @@ struct KinectSensor::Impl {
     bool needs_color = false;
     bool needs_occlusion = false;
     bool needs_ir = false;  // materials per pixel (the structured-light mode's depth view)
-    // x positions of the light sources whose occlusion makes pixels missing, in this view's frame.
+    // x positions of the light sources whose occlusion makes pixels missing, in this view's frame,
+    // and the bit each sets in Geometry::occluded (internal::kProjectorShadowBit, kIrCameraBit).
     std::vector<double> occluder_sources;
+    std::vector<uint8_t> occluder_bits;
     Geometry cache, current;
     bool cached = false;
     bool all_dirty = false;  // the working buffers differ from the cache anywhere
@@ -377,11 +379,11 @@ struct KinectSensor::Impl {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, rows.size(), 16),
                       [&](const tbb::blocked_range<size_t>& r) {
                         std::vector<float> us(width + 16);
-                        std::vector<uint8_t> scan(width + 16);
+                        std::vector<uint8_t> scan(2 * (width + 16));
                         for (size_t k = r.begin(); k != r.end(); ++k) {
                           const size_t row = static_cast<size_t>(rows[k]) * width;
-                          OccludeRow(&g.disparity[row], width, fx, view.occluder_sources, us.data(),
-                                     scan.data(), &g.occluded[row]);
+                          OccludeRow(&g.disparity[row], width, fx, view.occluder_sources,
+                                     view.occluder_bits, us.data(), scan.data(), &g.occluded[row]);
                         }
                       });
   }
@@ -474,51 +476,64 @@ struct KinectSensor::Impl {
             uint8_t* occluded = &g.occluded[row];
             for (int u = lo; u <= hi; ++u) {
               uint8_t any = 0;
-              for (size_t k = 0; k < sources; ++k) any |= flags[k][u];
-              occluded[u] = static_cast<uint8_t>(any & static_cast<uint8_t>(d[u] != 0.0f));
+              for (size_t k = 0; k < sources; ++k) {
+                any |= static_cast<uint8_t>(flags[k][u] * view.occluder_bits[k]);
+              }
+              occluded[u] = d[u] != 0.0f ? any : uint8_t{0};
             }
             written = {change.row, lo, hi};
           }
         });
   }
 
-  // us and scan: scratch of at least width + 16 entries.
+  // One source's occlusion scan of a row (us from SourceRow, padded): scan[u] = 1 where the
+  // source does not see pixel u.
+  static void ScanSource(const float* us, int width, int padded, bool from_right, bool vector,
+                         uint8_t* scan) {
+    static_cast<void>(vector);  // without the AVX-512 kernels
+#if MMH_SENSOR_AVX512
+    if (vector) {
+      if (from_right) {
+        OcclusionScanAvx512<true>(us, padded, scan);
+      } else {
+        OcclusionScanAvx512<false>(us, padded, scan);
+      }
+      return;
+    }
+#endif
+    if (from_right) {
+      // Scanning from the source's side (+x): hidden iff not left of everything right of it.
+      float lowest = std::numeric_limits<float>::infinity();
+      for (int u = width - 1; u >= 0; --u) {
+        scan[u] |= static_cast<uint8_t>(us[u] >= lowest);
+        lowest = std::min(lowest, us[u]);
+      }
+    } else {
+      float highest = -std::numeric_limits<float>::infinity();
+      for (int u = 0; u < width; ++u) {
+        scan[u] |= static_cast<uint8_t>(us[u] <= highest);
+        highest = std::max(highest, us[u]);
+      }
+    }
+  }
+
+  // us: scratch of at least width + 16 entries; scan: of twice that (one source's flags, and
+  // the sources' bits).
   void OccludeRow(const float* disparity, int width, double fx, const std::vector<double>& sources,
-                  float* us, uint8_t* scan, uint8_t* occluded) const {
+                  const std::vector<uint8_t>& bits, float* us, uint8_t* scan,
+                  uint8_t* occluded) const {
     const int padded = (width + 15) / 16 * 16;
     const bool vector = UseAvx512().load(std::memory_order_relaxed) && MMH_SENSOR_AVX512;
-    std::fill(scan, scan + padded, 0);
-    for (double source_x : sources) {
-      SourceRow(disparity, width, fx, source_x, us);
-#if MMH_SENSOR_AVX512
-      if (vector) {
-        if (source_x > 0) {
-          OcclusionScanAvx512<true>(us, padded, scan);
-        } else {
-          OcclusionScanAvx512<false>(us, padded, scan);
-        }
-        continue;
-      }
-#endif
-      if (source_x > 0) {
-        // Scanning from the source's side (+x): hidden iff not left of everything right of it.
-        float lowest = std::numeric_limits<float>::infinity();
-        for (int u = width - 1; u >= 0; --u) {
-          scan[u] |= static_cast<uint8_t>(us[u] >= lowest);
-          lowest = std::min(lowest, us[u]);
-        }
-      } else {
-        float highest = -std::numeric_limits<float>::infinity();
-        for (int u = 0; u < width; ++u) {
-          scan[u] |= static_cast<uint8_t>(us[u] <= highest);
-          highest = std::max(highest, us[u]);
-        }
-      }
+    uint8_t* all = scan + padded;
+    std::fill(all, all + padded, 0);
+    for (size_t k = 0; k < sources.size(); ++k) {
+      std::fill(scan, scan + padded, 0);
+      SourceRow(disparity, width, fx, sources[k], us);
+      ScanSource(us, width, padded, sources[k] > 0, vector, scan);
+      for (int u = 0; u < padded; ++u) all[u] |= static_cast<uint8_t>(scan[u] * bits[k]);
     }
     // Pixels that see nothing are not occluded (they are missing anyway).
-    for (int u = 0; u < width; ++u) {
-      occluded[u] = static_cast<uint8_t>(scan[u] & static_cast<uint8_t>(disparity[u] != 0.0f));
-    }
+    for (int u = 0; u < width; ++u) occluded[u] = disparity[u] != 0.0f ? all[u] : uint8_t{0};
   }
 
   // The pixels whose rays can hit a moving object: per object, the projections of its cluster
@@ -810,9 +825,11 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
     if (options.missing.projector_shadow) {
       s.color_view.occluder_sources.push_back(-options.ir_camera_offset +
                                               options.calibration.baseline);
+      s.color_view.occluder_bits.push_back(internal::kProjectorShadowBit);
     }
     if (options.missing.ir_camera_occlusion && options.ir_camera_offset != 0) {
       s.color_view.occluder_sources.push_back(-options.ir_camera_offset);
+      s.color_view.occluder_bits.push_back(internal::kIrCameraBit);
     }
   } else {
     s.ir_view.intrinsics = options.ir_intrinsics;
@@ -820,6 +837,7 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
     s.ir_view.needs_occlusion = true;
     if (options.missing.projector_shadow) {
       s.ir_view.occluder_sources.push_back(options.calibration.baseline);
+      s.ir_view.occluder_bits.push_back(internal::kProjectorShadowBit);
     }
   }
 

@@ -81,6 +81,11 @@ struct StructuredLightOptions {
   // per-pixel search costs about 6 times the IR image and matching step; requires
   // subpixel_steps 8 (the pattern's sampling).
   bool lattice_search = false;
+  // Match windows centred in the projector's shadow like any other, so that the correlation
+  // decides (a window whose lit part correlates keeps its depth, as on the device, which does not
+  // know where the shadow is; docs/sensor.md, "The step law of the bands"); false rejects them
+  // outright. Off until the cascade that a change of every frame needs.
+  bool match_in_shadow = false;
 
   template <class V>
   void VisitFields(V& v) {
@@ -102,6 +107,7 @@ struct StructuredLightOptions {
     v("edge_candidates", edge_candidates);
     v("parabola_subpixel", parabola_subpixel);
     v("lattice_search", lattice_search);
+    v("match_in_shadow", match_in_shadow);
   }
   void Validate(const std::string& prefix) const;
 };

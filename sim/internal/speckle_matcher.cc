@@ -255,12 +255,13 @@ MMH_SIMD_CLONES void Centres(const float* __restrict disparity, int largest, siz
   }
 }
 
-// Why a pixel is not searched before its window is looked at: nothing hit, or IR shadow.
+// Why a pixel is not searched before its window is looked at: nothing hit, or hidden from a
+// source whose bit is in `blocking` (SpeckleScene::occluded).
 MMH_SIMD_CLONES void GeometryBlocked(const int* __restrict centre,
-                                     const uint8_t* __restrict occluded, size_t n,
+                                     const uint8_t* __restrict occluded, uint8_t blocking, size_t n,
                                      int* __restrict blocked) {
   for (size_t p = 0; p < n; ++p) {
-    const int shadow = occluded[p] != 0 ? static_cast<int>(MissingCause::kShadow) : 0;
+    const int shadow = (occluded[p] & blocking) != 0 ? static_cast<int>(MissingCause::kShadow) : 0;
     blocked[p] = centre[p] < 0 ? static_cast<int>(MissingCause::kNothing) : shadow;
   }
 }
@@ -561,7 +562,14 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
   blocked_.resize(pixels);
   Centres(scene.disparity, max_d_ - options_.search_px - 2, pixels, centre_.data(),
           centre_low_.data());
-  GeometryBlocked(centre_.data(), scene.occluded, pixels, blocked_.data());
+  // A window centred in the projector's shadow is matched like any other when
+  // match_in_shadow: its lit part may still correlate, as on the device, which does not know
+  // where the shadow is. The IR camera's occlusion stays blocked (the IR image here is the
+  // delivered camera's, not the IR camera's own view).
+  const uint8_t blocking = options_.match_in_shadow
+                               ? kIrCameraBit
+                               : static_cast<uint8_t>(kProjectorShadowBit | kIrCameraBit);
+  GeometryBlocked(centre_.data(), scene.occluded, blocking, pixels, blocked_.data());
   // Depth units of each raw value on the lattice (0: outside [min_depth, max_depth]).
   units_by_raw_.assign(2048, 0);  // 2048: raw 2047 means "off the lattice"
   for (int raw = 0; raw <= 2046; ++raw) {

@@ -11,12 +11,17 @@
 
 namespace mmh::sim::internal {
 
+// SpeckleScene::occluded's bits: which source does not see the pixel.
+inline constexpr uint8_t kProjectorShadowBit = 1;
+inline constexpr uint8_t kIrCameraBit = 2;
+
 // Per-pixel geometry of the depth view (#width by #height, row-major).
 struct SpeckleScene {
   const float* depth = nullptr;          // along the optical axis [m]; +inf where nothing was hit
   const float* disparity = nullptr;      // IR disparity f b / z [px]; 0 where nothing was hit
   const float* cos_incidence = nullptr;  // in [0, 1]
-  const uint8_t* occluded = nullptr;     // hidden from the projector or the IR camera
+  // Hidden from the projector (kProjectorShadowBit) or the IR camera (kIrCameraBit); 0: seen.
+  const uint8_t* occluded = nullptr;
   const float* ir_diffuse = nullptr;     // SurfaceMaterial: ir_albedo (1 - specularity)
   const float* ir_specular = nullptr;    // SurfaceMaterial: specularity
 };

@@ -45,7 +45,8 @@ TestScene MakeScene() {
       const size_t p = static_cast<size_t>(v) * kWidth + u;
       if (u == 150) continue;                                   // nothing hit
       double z = u < 90 ? 0.9 : 1.6 + 0.004 * v + 0.001 * u;    // a step, then a slanted floor
-      if (u >= 100 && u < 104) s.occluded[p] = 1;               // IR shadow beside the step
+      if (u >= 100 && u < 104) s.occluded[p] = kProjectorShadowBit;  // IR shadow beside the step
+      if (u >= 86 && u < 88) s.occluded[p] = kIrCameraBit;           // hidden from the IR camera
       if (u >= 170 && v >= 30 && v < 50) s.diffuse[p] = 0.02f;  // dark
       if (u >= 20 && u < 40 && v >= 20 && v < 40) {             // glossy, facing the camera
         s.specular[p] = 0.3f;
@@ -88,7 +89,11 @@ struct Oracle {
       return matcher.SearchCentre(scene.disparity[y * kWidth + x]);
     };
     if (centre(u, v) < 0) return MissingCause::kNothing;
-    if (scene.occluded[p]) return MissingCause::kShadow;
+    // Hidden from the IR camera: never matched; in the projector's shadow: unless
+    // match_in_shadow.
+    if ((scene.occluded[p] & (o.match_in_shadow ? kIrCameraBit : 0xff)) != 0) {
+      return MissingCause::kShadow;
+    }
     const double levels = (1 << o.adc_bits) - 1;
     double mean_a = 0;
     for (int j = -rad; j <= rad; ++j) {
@@ -161,8 +166,7 @@ struct Oracle {
   }
 };
 
-TEST(SpeckleMatcher, MatchesTheBruteForceCorrelationOfEveryWindow) {
-  StructuredLightOptions options;
+void ExpectTheBruteForceCorrelationOfEveryWindow(const StructuredLightOptions& options) {
   const TestScene scene = MakeScene();
   const double max_disparity = kFocalBaseline / 0.4;
   SpeckleMatcher matcher(options, kWidth, kHeight, max_disparity);
@@ -196,10 +200,23 @@ TEST(SpeckleMatcher, MatchesTheBruteForceCorrelationOfEveryWindow) {
   EXPECT_LE(differ, static_cast<int>(n / 2000)) << differ << " of " << n << " pixels differ";
 }
 
+TEST(SpeckleMatcher, MatchesTheBruteForceCorrelationOfEveryWindow) {
+  ExpectTheBruteForceCorrelationOfEveryWindow(StructuredLightOptions());
+}
+
+// match_in_shadow: the projector's shadow is matched like any window (its pixels become low
+// signal or matched where their lit part correlates), the IR camera's occlusion is not.
+TEST(SpeckleMatcher, MatchingInTheShadowIsTheBruteForceCorrelationToo) {
+  StructuredLightOptions options;
+  options.match_in_shadow = true;
+  ExpectTheBruteForceCorrelationOfEveryWindow(options);
+}
+
 TEST(SpeckleMatcher, GivesTheSameBytesForAnyThreadCount) {
   for (const bool lattice : {false, true}) {
     StructuredLightOptions options;
     options.lattice_search = lattice;
+    options.match_in_shadow = lattice;
     const TestScene scene = MakeScene();
     const size_t n = static_cast<size_t>(kWidth) * kHeight;
     std::vector<uint16_t> ir(n), depth1(n), depth2(n);
