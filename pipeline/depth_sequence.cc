@@ -120,11 +120,8 @@ sim::RealView ReadRealView(const std::filesystem::path& folder, const std::files
                            const std::filesystem::path& model,
                            const std::filesystem::path& trajectory,
                            const sim::KinectSensorOptions& sensor, int frames) {
-  if (frames < 1) {
-    frames = std::min(-frames, track::RecordingFrameSource(folder).size());
-    if (frames < 1) ThrowBadValue(folder.string() + ": frames", "0", "at least 1 frame");
-  }
   sim::DepthSequence sequence = ReadDepthSequence(folder, frames);
+  frames = static_cast<int>(sequence.depth_m.size());
   sim::RealView real;
   real.name = sequence.name + " frame 1";
   real.width = sequence.width;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "metrics/tracking_metrics.h"
 #include "sim/internal/counter_random.h"
 #include "sim/internal/depth_sample.h"
 
@@ -63,14 +64,6 @@ Line FitLeastAbsoluteDeviations(std::span<const StepRun> runs) {
   }
   const double slope = 0.5 * (low + high);
   return {slope, BestIntercept(runs, slope)};
-}
-
-// The q-quantile of sorted values, interpolated linearly between order statistics (R's type 7).
-double Quantile(const std::vector<double>& sorted, double q) {
-  const double h = (sorted.size() - 1) * q;
-  const size_t below = static_cast<size_t>(std::floor(h));
-  const size_t above = std::min(below + 1, sorted.size() - 1);
-  return sorted[below] + (h - below) * (sorted[above] - sorted[below]);
 }
 
 }  // namespace
@@ -156,9 +149,8 @@ StepLaw FitStepLaw(std::span<const StepRun> runs, const StepLawOptions& options)
   if (!kept.empty()) {
     std::vector<double> steps;
     for (const StepRun& r : kept) steps.push_back(r.step_px_per_m);
-    std::sort(steps.begin(), steps.end());
-    law.step_p10_px_per_m = Quantile(steps, 0.1);
-    law.step_p90_px_per_m = Quantile(steps, 0.9);
+    law.step_p10_px_per_m = metrics::Quantile(steps, 0.1);
+    law.step_p90_px_per_m = metrics::Quantile(steps, 0.9);
   }
   const auto [lowest, highest] = std::minmax_element(
       kept.begin(), kept.end(),
@@ -178,10 +170,9 @@ StepLaw FitStepLaw(std::span<const StepRun> runs, const StepLawOptions& options)
     for (uint64_t i = 0; i < n; ++i) sample[i] = kept[internal::Mix64(key + i) % n];
     slopes.push_back(FitLeastAbsoluteDeviations(sample).slope_m);
   }
-  std::sort(slopes.begin(), slopes.end());
   const double tail = (1 - options.confidence) / 2;
-  law.slope_low_m = Quantile(slopes, tail);
-  law.slope_high_m = Quantile(slopes, 1 - tail);
+  law.slope_low_m = metrics::Quantile(slopes, tail);
+  law.slope_high_m = metrics::Quantile(slopes, 1 - tail);
   return law;
 }
 
