@@ -27,6 +27,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -131,6 +132,13 @@ struct NeighbourhoodStructure {
   // Median over those runs' pixels of BandWidthsAcross (NaN: no run).
   double shadow_band_across_px = 0, edge_band_across_px = 0;
   int shadow_runs = 0, edge_runs = 0;
+  // The object's silhouette (sim/silhouette_bleed.h), where the mask is an object's (NaN
+  // otherwise): the mean bleed and erosion at its shadow-side and edge-side ends.
+  double shadow_side_bleed_px = std::numeric_limits<double>::quiet_NaN();
+  double edge_side_bleed_px = std::numeric_limits<double>::quiet_NaN();
+  double shadow_side_erosion_px = std::numeric_limits<double>::quiet_NaN();
+  double edge_side_erosion_px = std::numeric_limits<double>::quiet_NaN();
+  int shadow_side_ends = 0, edge_side_ends = 0;  // the silhouette's ends measured
 };
 // `excluded` (empty, or width x height, non-zero = left out): pixels taken out of the
 // neighbourhood, and runs with a pixel there not counted: the parts of a real frame near objects

@@ -11,6 +11,7 @@
 #include "core/image_io.h"
 #include "core/tum_io.h"
 #include "sim/kinect_sensor.h"
+#include "sim/silhouette_bleed.h"
 
 namespace mmh::sim {
 namespace {
@@ -194,6 +195,32 @@ std::vector<uint8_t> ResampleMask(const std::vector<uint8_t>& mask, const Pinhol
   return out;
 }
 
+// The object's neighbourhood (AnalyseNeighbourhood) with its silhouette's bleed and erosion
+// (MeasureSilhouetteBleed), in a frame whose pixels are `pixel_scale` of the rendered sensor's: the
+// bleed's pixel counts are the rendered sensor's, carried to the frame's pixels.
+NeighbourhoodStructure AroundObject(const std::vector<float>& depth_m, int width, int height,
+                                    std::span<const uint8_t> mask, int radius_px,
+                                    double pixel_scale, std::span<const uint8_t> excluded = {}) {
+  NeighbourhoodStructure n =
+      AnalyseNeighbourhood(depth_m, width, height, mask, radius_px, {}, excluded);
+  SilhouetteBleedOptions options;
+  auto in_frame = [&](int px) { return static_cast<int>(std::lround(px / pixel_scale)); };
+  options.reference_px = in_frame(options.reference_px);
+  options.min_run_px = in_frame(options.min_run_px);
+  options.max_px = in_frame(options.max_px);
+  options.background_from_px = in_frame(options.background_from_px);
+  options.background_to_px = in_frame(options.background_to_px);
+  const SilhouetteBleed bleed =
+      MeasureSilhouetteBleed(depth_m, width, height, mask, options, excluded);
+  n.shadow_side_bleed_px = bleed.shadow_side.bleed_px;
+  n.edge_side_bleed_px = bleed.edge_side.bleed_px;
+  n.shadow_side_erosion_px = bleed.shadow_side.erosion_px;
+  n.edge_side_erosion_px = bleed.edge_side.erosion_px;
+  n.shadow_side_ends = bleed.shadow_side.ends;
+  n.edge_side_ends = bleed.edge_side.ends;
+  return n;
+}
+
 // The real view rendered in both modes, and each frame's neighbourhood of the object beside the
 // real frame's (docs/sensor.md, "Like for like").
 void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
@@ -242,7 +269,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const int real_radius = static_cast<int>(std::lround(kNeighbourhoodRadiusPx / real_scale));
   report.like_for_like.push_back(
       {view.name, real_scale,
-       AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius)});
+       AroundObject(view.depth_m, view.width, view.height, view.mask, real_radius, real_scale)});
   report.real_near.push_back(report.like_for_like.back().structure);
   StepRuns real_runs;
   real_runs.Add(view.depth_m, view.width, view.height, view.intrinsics.fx);
@@ -253,7 +280,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
                     "the first frame's size, with its mask and other objects' mask");
     }
     report.real_near.push_back(
-        AnalyseNeighbourhood(frame.depth_m, view.width, view.height, frame.mask, real_radius));
+        AroundObject(frame.depth_m, view.width, view.height, frame.mask, real_radius, real_scale));
     real_runs.Add(frame.depth_m, view.width, view.height, view.intrinsics.fx);
   }
   report.view_step_laws.push_back(
@@ -270,13 +297,13 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     rendered_away = ResampleMask(real_away, view.intrinsics, intrinsics);
     report.like_for_like_away.push_back(
         {view.name, real_scale,
-         AnalyseNeighbourhood(view.depth_m, view.width, view.height, view.mask, real_radius, {},
-                              real_away)});
+         AroundObject(view.depth_m, view.width, view.height, view.mask, real_radius, real_scale,
+                      real_away)});
     report.real_away.push_back(report.like_for_like_away.back().structure);
     for (const RealView::Frame& frame : view.later_frames) {
       report.real_away.push_back(
-          AnalyseNeighbourhood(frame.depth_m, view.width, view.height, frame.mask, real_radius, {},
-                               GrowMask(frame.others, view.width, view.height, real_radius)));
+          AroundObject(frame.depth_m, view.width, view.height, frame.mask, real_radius, real_scale,
+                       GrowMask(frame.others, view.width, view.height, real_radius)));
     }
   }
   // Along the desk's edge: its pixels in the bare geometry (the exact render without the object,
@@ -358,12 +385,11 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     std::vector<float> depth_m = DepthMetresFromUnits(frame.depth, frame.depth_scale);
     report.like_for_like.push_back(
         {structured ? "view, SL" : "view, stat.", 1.0,
-         AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx)});
+         AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0)});
     if (!rendered_away.empty()) {
       report.like_for_like_away.push_back(
           {structured ? "view, SL" : "view, stat.", 1.0,
-           AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx, {},
-                                rendered_away)});
+           AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0, rendered_away)});
     }
     if (desk) {
       report.like_for_like_desk.push_back(
@@ -399,10 +425,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     const std::vector<float> depth_m = DepthMetresFromUnits(frame.depth, frame.depth_scale);
     report.pattern_seeds.push_back(options.structured_light.pattern_seed);
     report.pattern_near.push_back(
-        AnalyseNeighbourhood(depth_m, width, height, mask, kNeighbourhoodRadiusPx));
+        AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0));
     if (!rendered_away.empty()) {
-      report.pattern_away.push_back(AnalyseNeighbourhood(
-          depth_m, width, height, mask, kNeighbourhoodRadiusPx, {}, rendered_away));
+      report.pattern_away.push_back(
+          AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0, rendered_away));
     }
     if (desk) report.pattern_desk.push_back(analyse_desk(depth_m));
     pattern_runs.Add(depth_m, width, height, focal);
@@ -600,6 +626,14 @@ constexpr NeighbourhoodStatistic kNeighbourhoodStatistics[] = {
      [](const NeighbourhoodStructure& n, double s) { return n.shadow_band_across_px * s; }},
     {"edge band across [px]", "edge_band_across_px",
      [](const NeighbourhoodStructure& n, double s) { return n.edge_band_across_px * s; }},
+    {"bleed, shadow side [px]", "shadow_side_bleed_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.shadow_side_bleed_px * s; }},
+    {"bleed, edge side [px]", "edge_side_bleed_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.edge_side_bleed_px * s; }},
+    {"eroded, shadow side [px]", "shadow_side_erosion_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.shadow_side_erosion_px * s; }},
+    {"eroded, edge side [px]", "edge_side_erosion_px",
+     [](const NeighbourhoodStructure& n, double s) { return n.edge_side_erosion_px * s; }},
 };
 
 // Mean, sample standard deviation, minimum and maximum of values over patterns or frames. A band's
@@ -659,7 +693,14 @@ std::string SensorCheckReport::FormatNeighbourhoods(
   text += "   goal\n";
   const NeighbourhoodRow& real = rows.front();
   const NeighbourhoodRow& sl = rows.back();
+  // A statistic no row has (the silhouette's, along the desk's edge) is not printed.
+  auto measured = [&](const NeighbourhoodStatistic& statistic) {
+    return std::any_of(rows.begin(), rows.end(), [&](const NeighbourhoodRow& row) {
+      return !std::isnan(statistic.value(row.structure, row.pixel_scale));
+    });
+  };
   for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+    if (!measured(statistic)) continue;
     std::snprintf(line, sizeof(line), "%-24s", statistic.label);
     text += line;
     for (const NeighbourhoodRow& row : rows) {
@@ -677,16 +718,28 @@ std::string SensorCheckReport::FormatNeighbourhoods(
     }
     text += "   0.8-1.2\n";
   }
-  std::snprintf(line, sizeof(line), "%-24s", "runs (shadow, edge)");
-  text += line;
-  for (const NeighbourhoodRow& row : rows) {
-    std::snprintf(line, sizeof(line), "%26s",
-                  (std::to_string(row.structure.shadow_runs) + ", " +
-                   std::to_string(row.structure.edge_runs))
-                      .c_str());
+  // A row of two counts per frame.
+  auto counts = [&](const char* label, int NeighbourhoodStructure::*first,
+                    int NeighbourhoodStructure::*second) {
+    std::snprintf(line, sizeof(line), "%-24s", label);
     text += line;
+    for (const NeighbourhoodRow& row : rows) {
+      std::snprintf(
+          line, sizeof(line), "%26s",
+          (std::to_string(row.structure.*first) + ", " + std::to_string(row.structure.*second))
+              .c_str());
+      text += line;
+    }
+    text += "\n";
+  };
+  counts("runs (shadow, edge)", &NeighbourhoodStructure::shadow_runs,
+         &NeighbourhoodStructure::edge_runs);
+  if (std::any_of(rows.begin(), rows.end(), [](const NeighbourhoodRow& row) {
+        return row.structure.shadow_side_ends + row.structure.edge_side_ends > 0;
+      })) {
+    counts("silhouette ends (s, e)", &NeighbourhoodStructure::shadow_side_ends,
+           &NeighbourhoodStructure::edge_side_ends);
   }
-  text += "\n";
   if (real_frames.size() > 1 && !patterns.empty()) {
     std::snprintf(line, sizeof(line),
                   "  over real frames 1-%zu and %zu pattern%s: real mean (min-max), SL mean "
@@ -694,6 +747,7 @@ std::string SensorCheckReport::FormatNeighbourhoods(
                   real_frames.size(), patterns.size(), patterns.size() > 1 ? "s" : "");
     text += line;
     for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+      if (!measured(statistic)) continue;
       const ValueSpread r = SpreadOf(statistic, real_frames, real.pixel_scale);
       const ValueSpread sl = SpreadOf(statistic, patterns, 1.0);
       std::snprintf(line, sizeof(line), "  %-24s %8.2f (%.2f-%.2f) %8.2f (%.2f-%.2f) %8.2f\n",
@@ -740,8 +794,14 @@ nlohmann::json SensorCheckReport::ToJson() const {
                       {"edge_band_px", n.edge_band_px * row.pixel_scale},
                       {"shadow_band_across_px", n.shadow_band_across_px * row.pixel_scale},
                       {"edge_band_across_px", n.edge_band_across_px * row.pixel_scale},
+                      {"shadow_side_bleed_px", n.shadow_side_bleed_px * row.pixel_scale},
+                      {"edge_side_bleed_px", n.edge_side_bleed_px * row.pixel_scale},
+                      {"shadow_side_erosion_px", n.shadow_side_erosion_px * row.pixel_scale},
+                      {"edge_side_erosion_px", n.edge_side_erosion_px * row.pixel_scale},
                       {"shadow_runs", n.shadow_runs},
-                      {"edge_runs", n.edge_runs}});
+                      {"edge_runs", n.edge_runs},
+                      {"shadow_side_ends", n.shadow_side_ends},
+                      {"edge_side_ends", n.edge_side_ends}});
     }
     return like;
   };

@@ -84,7 +84,7 @@ struct StructuredLightOptions {
   // Match windows centred in the projector's shadow like any other, so that the correlation
   // decides (a window whose lit part correlates keeps its depth, as on the device, which does not
   // know where the shadow is; docs/sensor.md, "The step law of the bands"); false rejects them
-  // outright. Off until the cascade that a change of every frame needs.
+  // outright. Off: docs/sensor.md, "Why match_in_shadow stays off".
   bool match_in_shadow = false;
 
   template <class V>

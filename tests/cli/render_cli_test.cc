@@ -220,6 +220,23 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
     }
   }
   EXPECT_THAT(r.output, HasSubstr("edge band across [px]"));
+  // The object's silhouette (sim/silhouette_bleed.h), measured at both sides of the gelatin box in
+  // every frame. The statistical sensor's shadow is the geometric one, so nothing of the box
+  // bleeds into it; the real frame's box bleeds onto the table on both sides (measured 0.36 and
+  // 0.82 px) and loses less than a pixel of its outline.
+  for (const auto& row : like) {
+    EXPECT_GT(row["shadow_side_ends"].get<int>(), 30) << row.dump();
+    EXPECT_GT(row["edge_side_ends"].get<int>(), 30) << row.dump();
+    for (const char* key : {"shadow_side_bleed_px", "edge_side_bleed_px", "shadow_side_erosion_px",
+                            "edge_side_erosion_px"}) {
+      EXPECT_GE(row[key].get<double>(), 0.0) << key << " " << row.dump();
+      EXPECT_LT(row[key].get<double>(), 3.0) << key << " " << row.dump();
+    }
+  }
+  EXPECT_EQ(like[1]["shadow_side_bleed_px"].get<double>(), 0.0);
+  EXPECT_GT(like[0]["shadow_side_bleed_px"].get<double>(), 0.1);
+  EXPECT_GT(like[0]["edge_side_bleed_px"].get<double>(), 0.1);
+  EXPECT_THAT(r.output, HasSubstr("bleed, shadow side [px]"));
   // Along the desk's edge (the committed view's desk, fitted from the real frame): the real frame
   // and both modes see the floor beyond it, the IR shadow falls on it (runs of the shadow class in
   // every row that crosses the edge, about 120) and the rendered edge lies where the real one is
