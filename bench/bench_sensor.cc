@@ -34,11 +34,14 @@ struct Setup {
   std::unique_ptr<mmh::sim::TableTopScene> scene;
   std::unique_ptr<mmh::sim::KinectSensor> sensor;
 
-  explicit Setup(bool structured_light = false) {
+  // sensor: 0 statistical, 1 structured light, 2 structured light matched on the IR camera's
+  // grid and registered (StructuredLightOptions::match_on_ir_grid).
+  explicit Setup(int sensor_mode = 0) {
     config.scene.props = mmh::sim::TableProps::kCastle;
     // Both modes set explicitly: structured light is the default since 2026-11-29.
-    config.sensor.mode = structured_light ? mmh::sim::SensorMode::kStructuredLight
-                                          : mmh::sim::SensorMode::kStatistical;
+    config.sensor.mode = sensor_mode > 0 ? mmh::sim::SensorMode::kStructuredLight
+                                         : mmh::sim::SensorMode::kStatistical;
+    config.sensor.structured_light.match_on_ir_grid = sensor_mode == 2;
     scene = std::make_unique<mmh::sim::TableTopScene>(config, mmh::sim::LoadProxyModel("", 1.0));
     sensor = std::make_unique<mmh::sim::KinectSensor>(config.sensor, &scene->scene(),
                                                       scene->table_T_camera());
@@ -50,12 +53,13 @@ struct Setup {
   }
 };
 
-// structured_light: the sensor's structured-light mode (speckle image and block matching).
-Setup& SoldierScene(int worker, bool structured_light = false) {
-  static std::vector<std::unique_ptr<Setup>> setups[2];
-  auto& list = setups[structured_light ? 1 : 0];
+// sensor_mode: Setup's (1: the structured-light mode, speckle image and block matching; 2: matched
+// on the IR camera's grid).
+Setup& SoldierScene(int worker, int sensor_mode = 0) {
+  static std::vector<std::unique_ptr<Setup>> setups[3];
+  auto& list = setups[sensor_mode];
   while (static_cast<int>(list.size()) <= worker) {
-    list.push_back(std::make_unique<Setup>(structured_light));
+    list.push_back(std::make_unique<Setup>(sensor_mode));
   }
   return *list[worker];
 }
@@ -129,7 +133,8 @@ BENCHMARK(BM_SensorFrame)
 
 // Frame-level parallelism (mmh::sim::RenderFrames): one scene and sensor per worker, 120 frames
 // of the demo walk per iteration. Args: mode, workers, cores (0: all; 1: everything on one
-// thread, as one job of the pipeline renders its session), sensor mode (1: structured light).
+// thread, as one job of the pipeline renders its session), sensor mode (1: structured light; 2:
+// structured light matched on the IR camera's grid and registered).
 void BM_SensorFrames(benchmark::State& state) {
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
   std::unique_ptr<tbb::global_control> limit;
@@ -140,7 +145,7 @@ void BM_SensorFrames(benchmark::State& state) {
   const int count = 120;
   std::vector<mmh::sim::SensorWorker> workers;
   for (int w = 0; w < state.range(1); ++w) {
-    Setup& s = SoldierScene(w, state.range(3) == 1);
+    Setup& s = SoldierScene(w, static_cast<int>(state.range(3)));
     mmh::RgbdFrame frame;
     s.sensor->Render(0, mode, &frame);  // the static cache, outside the timing
     s.sensor->ResetTimings();
@@ -167,6 +172,8 @@ BENCHMARK(BM_SensorFrames)
     ->Args({0, 2, 0, 1})
     ->Args({1, 1, 1, 1})
     ->Args({1, 2, 0, 1})
+    ->Args({0, 2, 0, 2})
+    ->Args({1, 2, 0, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -18,6 +18,7 @@
 #include <span>
 
 #include "core/error.h"
+#include "sim/depth_registration.h"
 #include "sim/internal/avx2_kernels.h"
 #include "sim/internal/avx512_kernels.h"
 #include "sim/internal/color_noise.h"
@@ -264,6 +265,11 @@ struct KinectSensor::Impl {
   std::unique_ptr<internal::SpeckleMatcher> speckle;  // structured-light mode
   std::vector<uint16_t> ir_image;                      // structured-light mode, depth view
   std::vector<MissingCause> last_causes;     // when requested (KeepMissingCauses)
+  // Registered structured light matched on the IR camera's grid: the IR grid's depth and causes,
+  // then carried to the colour camera's (RegisterDepth).
+  bool ir_grid = false;
+  std::vector<uint16_t> ir_grid_depth;
+  std::vector<MissingCause> ir_grid_causes;
   std::vector<std::vector<uint8_t>> static_face_storage;
   std::vector<const uint8_t*> static_face_color;  // per object (ShadeStaticFaces)
   std::vector<bool> moving;
@@ -283,7 +289,11 @@ struct KinectSensor::Impl {
   std::vector<uint32_t> color_alias;    // ColorAliasTable
   int color_slot_bits = 1;
 
+  // The view whose depth the frame delivers, and the one the structured light is matched in: the
+  // IR camera's own unless the depth is registered and matched on the delivered grid (the
+  // model's shortcut; StructuredLightOptions::match_on_ir_grid false).
   View& depth_view() { return options.registered ? color_view : ir_view; }
+  View& match_view() { return options.registered && !ir_grid ? color_view : ir_view; }
   Rigid3 ColorTDepth() { return color_view.world_T_view.Inverse() * depth_view().world_T_view; }
 
   // One row of the depth image: the vector part for every pixel, then, for edge pixels only,
@@ -677,8 +687,8 @@ struct KinectSensor::Impl {
 
   // The structured-light mode's depth image: the IR image of the speckle pattern, then block
   // matching (internal::SpeckleMatcher).
-  void StructuredLightDepth(uint64_t frame_key, uint16_t* depth) {
-    const View& dv = depth_view();
+  void StructuredLightDepth(uint64_t frame_key, uint16_t* depth, MissingCause* causes) {
+    const View& dv = match_view();
     const Geometry& g = dv.current;
     internal::SpeckleScene scene{g.depth.data(),    g.disparity.data(),  g.cos_incidence.data(),
                                  g.occluded.data(), g.ir_diffuse.data(), g.ir_specular.data()};
@@ -693,7 +703,44 @@ struct KinectSensor::Impl {
     out.min_depth = static_cast<float>(options.min_depth);
     out.max_depth = static_cast<float>(options.max_depth);
     out.inverse_scale = static_cast<float>(1.0 / kTumDepthScale);
-    speckle->Match(scene, ir_image.data(), out, depth, last_causes.empty() ? nullptr : last_causes.data());
+    speckle->Match(scene, ir_image.data(), out, depth, causes);
+  }
+
+  // Structured light matched on the IR camera's grid and registered to the colour camera's, as
+  // the device's driver does (sim/depth_registration.h, the exact footprint). A delivered pixel's
+  // cause is its IR pixel's, that of the IR pixel whose true surface is nearest there when its
+  // depth is missing; no IR pixel there: the IR camera did not see what the colour camera sees
+  // (kShadow), or nothing was hit.
+  void RegisteredStructuredLightDepth(uint64_t frame_key, uint16_t* depth) {
+    const View& iv = ir_view;
+    const size_t ir_pixels = iv.intrinsics.pixel_count();
+    ir_grid_depth.resize(ir_pixels);
+    const bool causes = !last_causes.empty();
+    if (causes) ir_grid_causes.assign(ir_pixels, MissingCause::kValid);
+    StructuredLightDepth(frame_key, ir_grid_depth.data(), causes ? ir_grid_causes.data() : nullptr);
+    std::vector<float> ir_m(ir_pixels);
+    for (size_t p = 0; p < ir_pixels; ++p) ir_m[p] = ir_grid_depth[p] * kTumDepthScale;
+    const Rigid3 color_T_ir = color_view.world_T_view.Inverse() * iv.world_T_view;
+    std::vector<int32_t> source;
+    const std::vector<float> registered = RegisterDepth(ir_m, iv.intrinsics, color_view.intrinsics,
+                                                        color_T_ir, {}, causes ? &source : nullptr);
+    for (size_t p = 0; p < registered.size(); ++p) {
+      depth[p] = static_cast<uint16_t>(std::lround(registered[p] / kTumDepthScale));
+    }
+    if (!causes) return;
+    std::vector<int32_t> surface;
+    RegisterDepth(iv.current.depth, iv.intrinsics, color_view.intrinsics, color_T_ir, {}, &surface);
+    for (size_t p = 0; p < registered.size(); ++p) {
+      if (depth[p] != 0) {
+        last_causes[p] = MissingCause::kValid;
+      } else if (surface[p] < 0) {
+        last_causes[p] = std::isfinite(color_view.current.depth[p]) ? MissingCause::kShadow
+                                                                    : MissingCause::kNothing;
+      } else {
+        const MissingCause c = ir_grid_causes[surface[p]];
+        last_causes[p] = c != MissingCause::kValid ? c : MissingCause::kShadow;
+      }
+    }
   }
 
   void Output(int index, RgbdFrame* frame) {
@@ -746,7 +793,12 @@ struct KinectSensor::Impl {
     const int ch = ck.height;
 
     const bool structured = options.mode == SensorMode::kStructuredLight;
-    if (structured) StructuredLightDepth(frame_key, frame->depth.data());
+    if (structured && ir_grid) {
+      RegisteredStructuredLightDepth(frame_key, frame->depth.data());
+    } else if (structured) {
+      StructuredLightDepth(frame_key, frame->depth.data(),
+                           last_causes.empty() ? nullptr : last_causes.data());
+    }
     // Depth and colour rows in one loop (one task wakes both cores once per frame).
     const int rows = std::max(dh, ch);
     tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& r) {
@@ -820,7 +872,9 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
   s.color_view.intrinsics = options.intrinsics;
   s.color_view.world_T_view = world_T_camera;
   s.color_view.needs_color = true;
-  if (options.registered) {
+  s.ir_grid = options.registered && options.mode == SensorMode::kStructuredLight &&
+              options.structured_light.match_on_ir_grid;
+  if (options.registered && !s.ir_grid) {
     s.color_view.needs_occlusion = true;
     if (options.missing.projector_shadow) {
       s.color_view.occluder_sources.push_back(-options.ir_camera_offset +
@@ -884,10 +938,10 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
   s.color_alias = ColorAliasTable(options.color, &s.color_slot_bits);
   s.ShadeStaticFaces();
   if (options.mode == SensorMode::kStructuredLight) {
-    s.depth_view().needs_ir = true;
+    s.match_view().needs_ir = true;
     // Nearer than min_depth nothing matches (the device's range); 0.8 min_depth leaves room
     // for the noise.
-    const PinholeIntrinsics& k = s.depth_view().intrinsics;
+    const PinholeIntrinsics& k = s.match_view().intrinsics;
     s.speckle = std::make_unique<internal::SpeckleMatcher>(
         options.structured_light, k.width, k.height,
         options.calibration.ir_focal_length * options.calibration.baseline /
@@ -908,7 +962,7 @@ void KinectSensor::Render(int index, RenderMode mode, RgbdFrame* frame) {
   Impl& s = *impl_;
   const uint64_t rays_before = s.scene->rays_cast();
   s.UpdateGeometry(s.color_view, mode);
-  if (!s.options.registered) s.UpdateGeometry(s.ir_view, mode);
+  if (!s.options.registered || s.ir_grid) s.UpdateGeometry(s.ir_view, mode);
   const auto t0 = Clock::now();
   s.Output(index, frame);
   s.timings.noise += Seconds(t0, Clock::now());

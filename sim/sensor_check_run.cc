@@ -436,6 +436,20 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   report.view_step_laws.push_back(pattern_runs.Fit(
       "view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
       focal, config.sensor));
+  // Matched on the IR camera's grid and registered to the colour camera's
+  // (StructuredLightOptions::match_on_ir_grid).
+  for (int k = 0; k < view.patterns; ++k) {
+    KinectSensorOptions options = config.sensor;
+    options.mode = SensorMode::kStructuredLight;
+    options.registered = true;
+    options.structured_light.match_on_ir_grid = true;
+    options.structured_light.pattern_seed += k;
+    KinectSensor sensor(options, &scene.scene(), scene.table_T_camera());
+    const RgbdFrame frame = sensor.Render(0);
+    report.pattern_near_ir_grid.push_back(
+        AroundObject(DepthMetresFromUnits(frame.depth, frame.depth_scale), width, height, mask,
+                     kNeighbourhoodRadiusPx, 1.0));
+  }
 }
 
 }  // namespace
@@ -595,9 +609,14 @@ std::string SensorCheckReport::FormatLikeForLike() const {
     std::snprintf(title, sizeof(title), format, kNeighbourhoodRadiusPx);
     text += FormatNeighbourhoods(title, rows, patterns, real_frames);
   };
-  add(like_for_like, pattern_near, real_near,
-      "\nlike for like: around the object (its mask grown by %d px), band widths in the "
-      "rendered sensor's pixels\n");
+  if (!like_for_like.empty()) {
+    std::snprintf(title, sizeof(title),
+                  "\nlike for like: around the object (its mask grown by %d px), band widths in "
+                  "the rendered sensor's pixels\n",
+                  kNeighbourhoodRadiusPx);
+    text +=
+        FormatNeighbourhoods(title, like_for_like, pattern_near, real_near, pattern_near_ir_grid);
+  }
   add(like_for_like_away, pattern_away, real_away,
       "\nlike for like, away from the other objects (the real frame's other labels grown by %d "
       "px, left out of both)\n");
@@ -676,7 +695,8 @@ ValueSpread SpreadOf(const NeighbourhoodStatistic& statistic,
 std::string SensorCheckReport::FormatNeighbourhoods(
     const std::string& title, const std::vector<NeighbourhoodRow>& rows,
     const std::vector<NeighbourhoodStructure>& patterns,
-    const std::vector<NeighbourhoodStructure>& real_frames) {
+    const std::vector<NeighbourhoodStructure>& real_frames,
+    const std::vector<NeighbourhoodStructure>& ir_grid_patterns) {
   char line[200];
   std::string text = title;
   std::snprintf(line, sizeof(line), "%-24s", "");
@@ -743,17 +763,27 @@ std::string SensorCheckReport::FormatNeighbourhoods(
   if (real_frames.size() > 1 && !patterns.empty()) {
     std::snprintf(line, sizeof(line),
                   "  over real frames 1-%zu and %zu pattern%s: real mean (min-max), SL mean "
-                  "(min-max), SL/real of the means\n",
-                  real_frames.size(), patterns.size(), patterns.size() > 1 ? "s" : "");
+                  "(min-max), SL/real of the means%s\n",
+                  real_frames.size(), patterns.size(), patterns.size() > 1 ? "s" : "",
+                  ir_grid_patterns.empty() ? ""
+                                           : "; then SL matched on the IR camera's grid and "
+                                             "registered: mean (min-max), /real");
     text += line;
     for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
       if (!measured(statistic)) continue;
       const ValueSpread r = SpreadOf(statistic, real_frames, real.pixel_scale);
       const ValueSpread sl = SpreadOf(statistic, patterns, 1.0);
-      std::snprintf(line, sizeof(line), "  %-24s %8.2f (%.2f-%.2f) %8.2f (%.2f-%.2f) %8.2f\n",
+      std::snprintf(line, sizeof(line), "  %-24s %8.2f (%.2f-%.2f) %8.2f (%.2f-%.2f) %8.2f",
                     statistic.label, r.mean, r.min, r.max, sl.mean, sl.min, sl.max,
                     sl.mean / r.mean);
       text += line;
+      if (!ir_grid_patterns.empty()) {
+        const ValueSpread ir = SpreadOf(statistic, ir_grid_patterns, 1.0);
+        std::snprintf(line, sizeof(line), " %8.2f (%.2f-%.2f) %8.2f", ir.mean, ir.min, ir.max,
+                      ir.mean / r.mean);
+        text += line;
+      }
+      text += "\n";
     }
   }
   return text;
@@ -854,6 +884,13 @@ nlohmann::json SensorCheckReport::ToJson() const {
     result["like_for_like_away_patterns"] = over_patterns(like_for_like_away, pattern_away);
   }
   if (!view_temporal.empty()) result["view_temporal_correlation"] = temporal_rows(view_temporal);
+  if (real_near.size() > 1 && !pattern_near_ir_grid.empty()) {
+    result["like_for_like_ir_grid_real_frames"] =
+        over_real_frames(like_for_like, real_near, pattern_near_ir_grid);
+  }
+  if (!pattern_near_ir_grid.empty()) {
+    result["like_for_like_ir_grid_patterns"] = over_patterns(like_for_like, pattern_near_ir_grid);
+  }
   if (real_near.size() > 1 && !pattern_near.empty()) {
     result["like_for_like_real_frames"] = over_real_frames(like_for_like, real_near, pattern_near);
   }

@@ -143,6 +143,11 @@ struct SensorCheckReport {
   // other objects (the latter empty without RealView::others).
   std::vector<uint64_t> pattern_seeds;
   std::vector<NeighbourhoodStructure> pattern_near, pattern_away;
+  // The same near the object with the IR image matched on the IR camera's own grid and the depth
+  // registered to the colour camera as the device's driver does (RegisterDepth, the exact
+  // footprint), per pattern: what the model's shortcut, matching on the delivered grid, changes at
+  // the object's outline (docs/sensor.md, "Matched on the IR camera's grid").
+  std::vector<NeighbourhoodStructure> pattern_near_ir_grid;
   // The real frames (the first is like_for_like's first row), near the object and away from the
   // other objects, in the real frame's pixels (like_for_like's first pixel_scale turns them into
   // the rendered sensor's).
@@ -167,7 +172,8 @@ struct SensorCheckReport {
   static std::string FormatNeighbourhoods(
       const std::string& title, const std::vector<NeighbourhoodRow>& rows,
       const std::vector<NeighbourhoodStructure>& patterns = {},
-      const std::vector<NeighbourhoodStructure>& real_frames = {});
+      const std::vector<NeighbourhoodStructure>& real_frames = {},
+      const std::vector<NeighbourhoodStructure>& ir_grid_patterns = {});
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };

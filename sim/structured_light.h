@@ -86,6 +86,14 @@ struct StructuredLightOptions {
   // know where the shadow is; docs/sensor.md, "The step law of the bands"); false rejects them
   // outright. Off: docs/sensor.md, "Why match_in_shadow stays off".
   bool match_in_shadow = false;
+  // With registered depth: render the IR image and match it on the IR camera's own grid
+  // (ir_intrinsics, 2.5 cm beside the colour camera), then carry the depth to the colour camera's
+  // image as the device's driver does (sim/depth_registration.h: each IR pixel's footprint, the
+  // nearest surface where they overlap), instead of matching on the delivered grid. The IR
+  // camera's occlusion then comes from the registration, and the object's outline bleeds as the
+  // real frames' does (docs/sensor.md, "Matched on the IR camera's grid"). Costs a second view's
+  // casts.
+  bool match_on_ir_grid = false;
 
   template <class V>
   void VisitFields(V& v) {
@@ -108,6 +116,7 @@ struct StructuredLightOptions {
     v("parabola_subpixel", parabola_subpixel);
     v("lattice_search", lattice_search);
     v("match_in_shadow", match_in_shadow);
+    v("match_on_ir_grid", match_on_ir_grid);
   }
   void Validate(const std::string& prefix) const;
 };

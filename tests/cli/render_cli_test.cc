@@ -237,6 +237,24 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   EXPECT_GT(like[0]["shadow_side_bleed_px"].get<double>(), 0.1);
   EXPECT_GT(like[0]["edge_side_bleed_px"].get<double>(), 0.1);
   EXPECT_THAT(r.output, HasSubstr("bleed, shadow side [px]"));
+  // Matched on the IR camera's grid and registered (match_on_ir_grid), over the 8 patterns: the
+  // registration carries the box's outline over the wall beside it on the edge side, which the
+  // delivered-grid shortcut does not (measured 0.65 px against 0.01; real 0.76).
+  const nlohmann::json checked = nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"));
+  const nlohmann::json& ir_grid = checked["like_for_like_ir_grid_patterns"]["patterns"];
+  const nlohmann::json& shortcut = checked["like_for_like_patterns"]["patterns"];
+  ASSERT_EQ(ir_grid.size(), 8u);
+  ASSERT_EQ(shortcut.size(), 8u);
+  double ir_bleed = 0, shortcut_bleed = 0;
+  for (size_t k = 0; k < 8; ++k) {
+    ir_bleed += ir_grid[k]["edge_side_bleed_px"].get<double>() / 8;
+    shortcut_bleed += shortcut[k]["edge_side_bleed_px"].get<double>() / 8;
+  }
+  EXPECT_GT(ir_bleed, 0.3);
+  EXPECT_LT(shortcut_bleed, 0.1);
+  EXPECT_GT(
+      checked["like_for_like_ir_grid_real_frames"]["ratio_of_means"]["missing_share"].get<double>(),
+      0.8);
   // Along the desk's edge (the committed view's desk, fitted from the real frame): the real frame
   // and both modes see the floor beyond it, the IR shadow falls on it (runs of the shadow class in
   // every row that crosses the edge, about 120) and the rendered edge lies where the real one is
