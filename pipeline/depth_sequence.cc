@@ -62,6 +62,12 @@ sim::DepthSequence ReadDepthSequence(const std::filesystem::path& folder, int fr
     for (int k = 0; k < frames; ++k) AddDepth(folder, k, reader.Read(k), sequence);
     return sequence;
   }
+  // RecordingFrameSource's own message names only the layouts it reads.
+  if (!track::DetectRecordingLayout(folder)) {
+    ThrowBadValue(folder.string(), "a folder of no known layout",
+                  "a TUM RGB-D folder (depth.txt), a BOP scene (scene_camera.json, "
+                  "scene_gt.json) or a YCB-Video folder (NNNNNN-depth.png with NNNNNN-meta.mat)");
+  }
   track::RecordingFrameSource source(folder);
   sequence.name = std::string("real ") + track::RecordingLayoutName(source.layout()) + " " +
                   folder.filename().string();
