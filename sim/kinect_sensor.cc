@@ -269,6 +269,7 @@ struct KinectSensor::Impl {
   // then carried to the colour camera's (RegisterDepth).
   bool ir_grid = false;
   std::vector<uint16_t> ir_grid_depth;
+  std::vector<float> ir_grid_depth_m;  // the same in metres, for RegisterDepth
   std::vector<MissingCause> ir_grid_causes;
   std::vector<std::vector<uint8_t>> static_face_storage;
   std::vector<const uint8_t*> static_face_color;  // per object (ShadeStaticFaces)
@@ -718,12 +719,15 @@ struct KinectSensor::Impl {
     const bool causes = !last_causes.empty();
     if (causes) ir_grid_causes.assign(ir_pixels, MissingCause::kValid);
     StructuredLightDepth(frame_key, ir_grid_depth.data(), causes ? ir_grid_causes.data() : nullptr);
-    std::vector<float> ir_m(ir_pixels);
-    for (size_t p = 0; p < ir_pixels; ++p) ir_m[p] = ir_grid_depth[p] * kTumDepthScale;
+    ir_grid_depth_m.resize(ir_pixels);
+    for (size_t p = 0; p < ir_pixels; ++p) {
+      ir_grid_depth_m[p] = static_cast<float>(ir_grid_depth[p] * kTumDepthScale);
+    }
     const Rigid3 color_T_ir = color_view.world_T_view.Inverse() * iv.world_T_view;
     std::vector<int32_t> source;
-    const std::vector<float> registered = RegisterDepth(ir_m, iv.intrinsics, color_view.intrinsics,
-                                                        color_T_ir, {}, causes ? &source : nullptr);
+    const std::vector<float> registered =
+        RegisterDepth(ir_grid_depth_m, iv.intrinsics, color_view.intrinsics, color_T_ir, {},
+                      causes ? &source : nullptr);
     for (size_t p = 0; p < registered.size(); ++p) {
       depth[p] = static_cast<uint16_t>(std::lround(registered[p] / kTumDepthScale));
     }

@@ -226,28 +226,43 @@ void AddBoardBeforeWall(RayScene& scene) {
   scene.Commit();
 }
 
+// The scene of AddBoardBeforeWall rendered whole with `options`, the missing causes kept, and the
+// board's first and last columns in the delivered image (half-width 0.1 m at 1 m).
+struct BoardFrame {
+  RgbdFrame frame;
+  std::vector<MissingCause> causes;
+  int left_edge = 0, right_edge = 0;
+};
+BoardFrame RenderBoard(const RayScene& scene, const KinectSensorOptions& options) {
+  KinectSensor sensor(options, &scene, Rigid3::Identity());
+  sensor.KeepMissingCauses(true);
+  BoardFrame b;
+  b.frame = sensor.Render(0, RenderMode::kFull);
+  b.causes.assign(sensor.missing_causes().begin(), sensor.missing_causes().end());
+  const PinholeIntrinsics& k = b.frame.depth_intrinsics;
+  b.left_edge = static_cast<int>(std::ceil(k.cx - k.fx * 0.1 / 1.0));
+  b.right_edge = static_cast<int>(std::floor(k.cx + k.fx * 0.1 / 1.0));
+  return b;
+}
+
 TEST(StructuredLight, ShadowOfANearBoxFallsOnTheProjectorSideAndIsMissing) {
   // A 20 cm board at 1 m in front of a wall at 2 m: the projector (at +x) cannot light a band
   // left of the board of width f_x s (1/z_near - 1/z_far) (s = 5 cm from the colour camera).
   RayScene scene;
   AddBoardBeforeWall(scene);
-  KinectSensor sensor(StructuredLight(), &scene, Rigid3::Identity());
-  sensor.KeepMissingCauses(true);
-  const RgbdFrame frame = sensor.Render(0, RenderMode::kFull);
+  const auto [frame, causes, left_edge, right_edge] = RenderBoard(scene, StructuredLight());
   const PinholeIntrinsics& k = frame.depth_intrinsics;
   const int v = 240;
-  const int left_edge = static_cast<int>(std::ceil(k.cx - k.fx * 0.1 / 1.0));
   const double shadow = k.fx * 0.05 * (1.0 / 1.0 - 1.0 / 2.0);  // about 13 px
   int missing_left = 0, shadow_cause = 0;
   for (int u = left_edge - static_cast<int>(shadow) + 2; u < left_edge - 2; ++u) {
     missing_left += frame.depth[v * k.width + u] == 0;
-    shadow_cause += sensor.missing_causes()[v * k.width + u] == MissingCause::kShadow;
+    shadow_cause += causes[v * k.width + u] == MissingCause::kShadow;
   }
   EXPECT_EQ(missing_left, static_cast<int>(shadow) - 4);
   EXPECT_EQ(shadow_cause, static_cast<int>(shadow) - 4);
   // Right of the board (the IR camera's side) no shadow: the wall is measured a few pixels
   // beyond the edge.
-  const int right_edge = static_cast<int>(std::floor(k.cx + k.fx * 0.1 / 1.0));
   int valid_right = 0;
   for (int u = right_edge + 8; u < right_edge + 20; ++u)
     valid_right += frame.depth[v * k.width + u] != 0;
@@ -264,11 +279,10 @@ TEST(StructuredLight, MatchingInTheShadowKeepsTheWallBesideItsEdge) {
   auto missing_left = [&](bool match_in_shadow, std::vector<MissingCause>* causes) {
     KinectSensorOptions options = StructuredLight();
     options.structured_light.match_in_shadow = match_in_shadow;
-    KinectSensor sensor(options, &scene, Rigid3::Identity());
-    sensor.KeepMissingCauses(true);
-    const RgbdFrame frame = sensor.Render(0, RenderMode::kFull);
+    const BoardFrame b = RenderBoard(scene, options);
+    const RgbdFrame& frame = b.frame;
     const PinholeIntrinsics& k = frame.depth_intrinsics;
-    const int left_edge = static_cast<int>(std::ceil(k.cx - k.fx * 0.1 / 1.0));
+    const int left_edge = b.left_edge;
     int missing = 0, valid = 0, on_a_surface = 0;
     for (int v = 200; v < 280; ++v) {
       for (int u = left_edge - 30; u < left_edge; ++u) {
@@ -282,7 +296,7 @@ TEST(StructuredLight, MatchingInTheShadowKeepsTheWallBesideItsEdge) {
           ++valid;
           on_a_surface += std::min(std::abs(z - 2.0), std::abs(z - 1.0)) < 0.06;
         }
-        if (causes != nullptr) causes->push_back(sensor.missing_causes()[p]);
+        if (causes != nullptr) causes->push_back(b.causes[p]);
       }
     }
     EXPECT_GT(on_a_surface, 0.95 * valid) << on_a_surface << " of " << valid;
@@ -308,22 +322,18 @@ TEST(StructuredLight, MatchedOnTheIrGridTheIrCamerasGapComesFromTheRegistration)
   AddBoardBeforeWall(scene);
   KinectSensorOptions options = StructuredLight();
   options.structured_light.match_on_ir_grid = true;
-  KinectSensor sensor(options, &scene, Rigid3::Identity());
-  sensor.KeepMissingCauses(true);
-  const RgbdFrame frame = sensor.Render(0, RenderMode::kFull);
+  const auto [frame, causes, left_edge, right_edge] = RenderBoard(scene, options);
   const PinholeIntrinsics& k = frame.depth_intrinsics;
   EXPECT_EQ(k.fx, options.intrinsics.fx);
   EXPECT_TRUE(frame.color_T_depth.translation.isZero());
-  ASSERT_EQ(sensor.missing_causes().size(), frame.depth.size());
-  const int right_edge = static_cast<int>(std::floor(k.cx + k.fx * 0.1 / 1.0));
-  const int left_edge = static_cast<int>(std::ceil(k.cx - k.fx * 0.1 / 1.0));
+  ASSERT_EQ(causes.size(), frame.depth.size());
   int gap = 0, gap_shadow = 0, wall_right = 0, shadow_left = 0, on_surface = 0, valid = 0;
   for (int v = 200; v < 280; ++v) {
     const size_t row = static_cast<size_t>(v) * k.width;
     // (The board's outline bleeds a pixel or two into the gap: from its third pixel on.)
     for (int u = right_edge + 3; u <= right_edge + 5; ++u) {
       gap += frame.depth[row + u] == 0;
-      gap_shadow += sensor.missing_causes()[row + u] == MissingCause::kShadow;
+      gap_shadow += causes[row + u] == MissingCause::kShadow;
     }
     for (int u = right_edge + 12; u < right_edge + 20; ++u) wall_right += frame.depth[row + u] != 0;
     for (int u = left_edge - 11; u < left_edge - 3; ++u) shadow_left += frame.depth[row + u] == 0;
