@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -51,31 +52,92 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
               cv::Scalar(options_.hue_max, 255, 255), green);
 
   const Rigid3 table_T_camera = camera_T_table.Inverse();
-  xs_.clear();
-  // Per image row, the block's leftmost and rightmost pixels (table x grows with image u).
-  std::vector<int> row_first(y1 - y0, -1), row_last(y1 - y0, -1);
+  points_.clear();
+  // A candidate block point: a green pixel at depth z [m] whose table position lies in the box,
+  // between min_height and top.
+  const auto add_point = [&](int u, int v, double z) {
+    const Eigen::Vector3d table_p = table_T_camera * k.BackProject(u, v, z);
+    if (table_p.z() < options_.min_height || table_p.z() > top ||
+        std::abs(table_p.x() - setup_.like_box_center_x) > hx ||
+        std::abs(table_p.y() - setup_.like_box_center_y) > hy) {
+      return false;
+    }
+    points_.push_back({u, v, static_cast<float>(z), static_cast<float>(table_p.x()),
+                       static_cast<float>(table_p.y())});
+    return true;
+  };
+  const int width = x1 - x0;
+  // Per pixel of a row: the depth [m] of a candidate there (0: none), and for a green pixel without
+  // depth the nearest candidate's depth and distance in its run of green.
+  std::vector<double> block_z(width), fill_z(width);
+  std::vector<int> distance(width);
+  constexpr int kFar = std::numeric_limits<int>::max();
   for (int v = y0; v < y1; ++v) {
-    for (int u = x0; u < x1; ++u) {
-      if (!green.at<uint8_t>(v - y0, u - x0)) continue;
-      const uint16_t d = frame.depth[static_cast<size_t>(v) * k.width + u];
-      if (d == 0) continue;
-      const Eigen::Vector3d table_p = table_T_camera * k.BackProject(u, v, d * frame.depth_scale);
-      if (table_p.z() < options_.min_height || table_p.z() > top ||
-          std::abs(table_p.x() - setup_.like_box_center_x) > hx ||
-          std::abs(table_p.y() - setup_.like_box_center_y) > hy) {
-        continue;
+    const uint8_t* mask = green.ptr<uint8_t>(v - y0);
+    const uint16_t* depth = frame.depth.data() + static_cast<size_t>(v) * k.width;
+    const size_t row_begin = points_.size();
+    for (int i = 0; i < width; ++i) {
+      block_z[i] = 0.0;
+      if (!mask[i] || depth[x0 + i] == 0) continue;
+      const double z = depth[x0 + i] * frame.depth_scale;
+      if (add_point(x0 + i, v, z)) block_z[i] = z;
+    }
+    // The colour camera sees block pixels whose depth is missing: where a finger hides the block
+    // from the IR camera beside the colour camera (the registration's gap), in the projector's
+    // shadow, at the outline. Each takes the depth of the nearest candidate in its run of green
+    // along the row (ties to the left), so that a row's extent is the colour image's.
+    if (options_.fill_missing_depth) {
+      for (int i = 0, last = -1; i < width; ++i) {
+        distance[i] = kFar;
+        if (!mask[i]) {
+          last = -1;
+        } else if (block_z[i] > 0) {
+          last = i;
+        } else if (last >= 0) {
+          distance[i] = i - last;
+          fill_z[i] = block_z[last];
+        }
       }
-      xs_.push_back(static_cast<float>(table_p.x()));
-      if (row_first[v - y0] < 0) row_first[v - y0] = u;
-      row_last[v - y0] = u;
+      for (int i = width - 1, next = -1; i >= 0; --i) {
+        if (!mask[i]) {
+          next = -1;
+        } else if (block_z[i] > 0) {
+          next = i;
+        } else if (next >= 0 && next - i < distance[i]) {
+          distance[i] = next - i;
+          fill_z[i] = block_z[next];
+        }
+      }
+      for (int i = 0; i < width; ++i) {
+        // A green pixel with a depth off the block (the table, the hand) is not filled.
+        if (distance[i] == kFar || depth[x0 + i] != 0) continue;
+        add_point(x0 + i, v, fill_z[i]);
+      }
+    }
+    // A block matcher spreads a nearer surface's depth over its neighbours (a finger's over the
+    // block's green pixels beside it), and such a pixel back-projects in front of the block. Along
+    // a row the block's front face or top is at one depth and its side face recedes from it: a
+    // candidate more than depth_margin nearer than the row's upper quartile of depth is an
+    // occluder's, and is dropped.
+    if (points_.size() > row_begin) {
+      row_z_.clear();
+      for (size_t j = row_begin; j < points_.size(); ++j) row_z_.push_back(points_[j].z);
+      const size_t q = (3 * (row_z_.size() - 1) + 2) / 4;
+      std::nth_element(row_z_.begin(), row_z_.begin() + q, row_z_.end());
+      const float nearest = row_z_[q] - static_cast<float>(options_.depth_margin);
+      points_.erase(std::remove_if(points_.begin() + row_begin, points_.end(),
+                                   [&](const BlockPoint& p) { return p.z < nearest; }),
+                    points_.end());
     }
   }
-  reading.points = static_cast<int>(xs_.size());
+  reading.points = static_cast<int>(points_.size());
   if (reading.points < options_.min_points) {
     reading.reason =
         "no green block in the Like box (" + std::to_string(reading.points) + " points)";
     return reading;
   }
+  xs_.clear();
+  for (const BlockPoint& p : points_) xs_.push_back(p.x);
   auto quantile = [&](double q) {
     const size_t i = std::min(xs_.size() - 1, static_cast<size_t>(q * (xs_.size() - 1) + 0.5));
     std::nth_element(xs_.begin(), xs_.begin() + i, xs_.end());
@@ -90,24 +152,31 @@ SliderReading SliderReader::Read(const RgbdFrame& frame, const Rigid3& camera_T_
   // end is the block's true edge and the centre lies half a block from it.
   const double size = setup_.slider_block_size;
   if (hi - lo < 0.9 * size) {
-    const auto depth_at = [&](int u, int v) {
-      return u >= 0 && u < k.width ? frame.depth[static_cast<size_t>(v) * k.width + u] : 0;
+    // Per image row, the block's leftmost and rightmost points (table x grows with image u).
+    struct RowEnds {
+      const BlockPoint* first = nullptr;
+      const BlockPoint* last = nullptr;
     };
-    const auto hidden = [&](int v, int edge, int step) {
-      const uint16_t block = depth_at(edge, v);
-      for (int u = edge + step; std::abs(u - edge) <= 3; u += step) {
-        const uint16_t d = depth_at(u, v);
-        if (d == 0) continue;
-        return static_cast<double>(block - d) * frame.depth_scale > 0.005;
+    std::vector<RowEnds> rows_ends(y1 - y0);
+    for (const BlockPoint& p : points_) {
+      RowEnds& r = rows_ends[p.v - y0];
+      if (!r.first || p.u < r.first->u) r.first = &p;
+      if (!r.last || p.u > r.last->u) r.last = &p;
+    }
+    const auto hidden = [&](const BlockPoint& end, int step) {
+      const uint16_t* depth = frame.depth.data() + static_cast<size_t>(end.v) * k.width;
+      for (int u = end.u + step; std::abs(u - end.u) <= 3 && u >= 0 && u < k.width; u += step) {
+        if (depth[u] == 0) continue;
+        return end.z - depth[u] * frame.depth_scale > 0.005;
       }
       return false;
     };
     int hidden_low = 0, hidden_high = 0, rows = 0;
-    for (int v = y0; v < y1; ++v) {
-      if (row_first[v - y0] < 0) continue;
+    for (const RowEnds& r : rows_ends) {
+      if (!r.first) continue;
       ++rows;
-      hidden_low += hidden(v, row_first[v - y0], -1);
-      hidden_high += hidden(v, row_last[v - y0], +1);
+      hidden_low += hidden(*r.first, -1);
+      hidden_high += hidden(*r.last, +1);
     }
     if (hidden_low > rows / 2 && hidden_low >= 2 * hidden_high) reading.center_x = hi - 0.5 * size;
     if (hidden_high > rows / 2 && hidden_high >= 2 * hidden_low) reading.center_x = lo + 0.5 * size;

@@ -4,7 +4,11 @@
 //
 // The block's centre is the middle of its extent along the box (robust quantiles of its points'
 // table-frame x): the camera sees one side face and the top, whose points span the block's full
-// length, so the middle is unbiased where a centroid of the visible points is not.
+// length, so the middle is unbiased where a centroid of the visible points is not. Per image row,
+// green pixels without depth take the depth of the nearest block point in their run of green (the
+// colour camera sees the block where the IR camera or the projector does not), and points much
+// nearer than the row's others (an occluding finger's depth spread by the block matcher) are
+// dropped; a hand hiding one end only is corrected for (docs/tracker.md, "Slider").
 #pragma once
 
 #include <optional>
@@ -32,6 +36,12 @@ struct SliderReaderOptions {
   double edge_quantile = 0.02;
   // A reading needs this many block points.
   int min_points = 15;
+  // Green pixels without depth in a row's run of green take the depth of the run's nearest block
+  // point, so that the extent is the colour image's (see slider_reader.cc).
+  bool fill_missing_depth = true;
+  // A row's block points lie within depth_margin [m] of its upper quartile of depth; nearer ones
+  // hold an occluder's depth (a finger's, spread by the block matcher).
+  double depth_margin = 0.01;
 
   template <class V>
   void VisitFields(V& v) {
@@ -44,6 +54,8 @@ struct SliderReaderOptions {
     v("box_margin", box_margin);
     v("edge_quantile", edge_quantile);
     v("min_points", min_points);
+    v("fill_missing_depth", fill_missing_depth);
+    v("depth_margin", depth_margin);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -69,9 +81,16 @@ class SliderReader {
   SliderReading Read(const RgbdFrame& frame, const Rigid3& camera_T_table);
 
  private:
+  // A block point: pixel, camera depth [m] and table x, y [m].
+  struct BlockPoint {
+    int u, v;
+    float z, x, y;
+  };
   TrackSetup setup_;
   SliderReaderOptions options_;
+  std::vector<BlockPoint> points_;
   std::vector<float> xs_;
+  std::vector<float> row_z_;
 };
 
 }  // namespace mmh::track

@@ -21,6 +21,7 @@ void SliderReaderOptions::Validate(const std::string& prefix) const {
   RequireNonNegative(min_height, prefix + ".min_height", "m");
   RequireNonNegative(max_height_margin, prefix + ".max_height_margin", "m");
   RequireNonNegative(box_margin, prefix + ".box_margin", "m");
+  RequireNonNegative(depth_margin, prefix + ".depth_margin", "m");
   if (!(edge_quantile >= 0 && edge_quantile < 0.5)) {
     ThrowBadValue(prefix + ".edge_quantile", FormatNumber(edge_quantile), "a value in [0, 0.5)");
   }
