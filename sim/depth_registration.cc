@@ -1,5 +1,8 @@
 #include "sim/depth_registration.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -40,13 +43,15 @@ std::vector<float> RegisterDepth(const std::vector<float>& depth_m, const Pinhol
   const Eigen::Vector3d t = to_T_from.translation;
   const double g = options.footprint_growth_px;
   // Fill the destination centres c with u0 - g <= c < u1 + g (half-open, so abutting footprints
-  // of a plane cover each centre once), the nearest depth winning; ties keep the lower source
-  // index (sources are visited in index order), so the bytes do not depend on the order of rows.
-  auto fill = [&](double u0, double u1, double v0, double v1, float depth, int32_t index) {
+  // of a plane cover each centre once) in rows [row_begin, row_end), the nearest depth winning;
+  // ties keep the lower source index (each destination row sees its sources in index order), so
+  // the bytes depend neither on the order of rows nor on the threads.
+  auto fill = [&](double u0, double u1, double v0, double v1, float depth, int32_t index,
+                  int row_begin, int row_end) {
     const int first_u = std::max(0, static_cast<int>(std::ceil(u0 - g)));
     const int last_u = std::min(to.width - 1, static_cast<int>(std::ceil(u1 + g)) - 1);
-    const int first_v = std::max(0, static_cast<int>(std::ceil(v0 - g)));
-    const int last_v = std::min(to.height - 1, static_cast<int>(std::ceil(v1 + g)) - 1);
+    const int first_v = std::max(row_begin, static_cast<int>(std::ceil(v0 - g)));
+    const int last_v = std::min(row_end - 1, static_cast<int>(std::ceil(v1 + g)) - 1);
     for (int y = first_v; y <= last_v; ++y) {
       const size_t row = static_cast<size_t>(y) * to.width;
       for (int x = first_u; x <= last_u; ++x) {
@@ -62,17 +67,25 @@ std::vector<float> RegisterDepth(const std::vector<float>& depth_m, const Pinhol
   const bool side_by_side = (r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-12 &&
                             std::abs(t.y()) < 1e-12 && std::abs(t.z()) < 1e-12;
   if (side_by_side) {
+    // Bands of destination rows in parallel: a source row's footprint spans the same destination
+    // rows at every depth, so each band visits only the source rows that reach it.
     const double su = to.fx / from.fx, sv = to.fy / from.fy;
-    for (int v = 0; v < from.height; ++v) {
-      const double v0 = sv * (v - 0.5 - from.cy) + to.cy, v1 = sv * (v + 0.5 - from.cy) + to.cy;
-      for (int u = 0; u < from.width; ++u) {
-        const float z = depth_m[static_cast<size_t>(v) * from.width + u];
-        if (!internal::ValidDepth(z)) continue;
-        const double shift = to.fx * t.x() / z + to.cx;
-        fill(su * (u - 0.5 - from.cx) + shift, su * (u + 0.5 - from.cx) + shift, v0, v1, z,
-             v * from.width + u);
-      }
-    }
+    tbb::parallel_for(tbb::blocked_range<int>(0, to.height, 16),
+                      [&](const tbb::blocked_range<int>& band) {
+                        for (int v = 0; v < from.height; ++v) {
+                          const double v0 = sv * (v - 0.5 - from.cy) + to.cy;
+                          const double v1 = sv * (v + 0.5 - from.cy) + to.cy;
+                          if (std::ceil(v1 + g) <= band.begin() || std::ceil(v0 - g) >= band.end())
+                            continue;
+                          for (int u = 0; u < from.width; ++u) {
+                            const float z = depth_m[static_cast<size_t>(v) * from.width + u];
+                            if (!internal::ValidDepth(z)) continue;
+                            const double shift = to.fx * t.x() / z + to.cx;
+                            fill(su * (u - 0.5 - from.cx) + shift, su * (u + 0.5 - from.cx) + shift,
+                                 v0, v1, z, v * from.width + u, band.begin(), band.end());
+                          }
+                        }
+                      });
   }
   for (int v = 0; v < from.height && !side_by_side; ++v) {
     for (int u = 0; u < from.width; ++u) {
@@ -104,7 +117,7 @@ std::vector<float> RegisterDepth(const std::vector<float>& depth_m, const Pinhol
         }
       }
       if (behind) continue;
-      fill(u0, u1, v0, v1, static_cast<float>(centre.z()), v * from.width + u);
+      fill(u0, u1, v0, v1, static_cast<float>(centre.z()), v * from.width + u, 0, to.height);
     }
   }
   for (float& z : out) {
