@@ -436,17 +436,18 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   report.view_step_laws.push_back(pattern_runs.Fit(
       "view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
       focal, config.sensor));
-  // Matched on the IR camera's grid and registered to the colour camera's
-  // (StructuredLightOptions::match_on_ir_grid).
+  // Matched on the other grid than the config's (StructuredLightOptions::match_on_ir_grid): the
+  // IR camera's, registered to the colour camera's, or the delivered one (the shortcut).
+  report.other_grid_is_ir = !config.sensor.structured_light.match_on_ir_grid;
   for (int k = 0; k < view.patterns; ++k) {
     KinectSensorOptions options = config.sensor;
     options.mode = SensorMode::kStructuredLight;
     options.registered = true;
-    options.structured_light.match_on_ir_grid = true;
+    options.structured_light.match_on_ir_grid = report.other_grid_is_ir;
     options.structured_light.pattern_seed += k;
     KinectSensor sensor(options, &scene.scene(), scene.table_T_camera());
     const RgbdFrame frame = sensor.Render(0);
-    report.pattern_near_ir_grid.push_back(
+    report.pattern_near_other_grid.push_back(
         AroundObject(DepthMetresFromUnits(frame.depth, frame.depth_scale), width, height, mask,
                      kNeighbourhoodRadiusPx, 1.0));
   }
@@ -614,8 +615,8 @@ std::string SensorCheckReport::FormatLikeForLike() const {
                   "\nlike for like: around the object (its mask grown by %d px), band widths in "
                   "the rendered sensor's pixels\n",
                   kNeighbourhoodRadiusPx);
-    text +=
-        FormatNeighbourhoods(title, like_for_like, pattern_near, real_near, pattern_near_ir_grid);
+    text += FormatNeighbourhoods(title, like_for_like, pattern_near, real_near,
+                                 pattern_near_other_grid);
   }
   add(like_for_like_away, pattern_away, real_away,
       "\nlike for like, away from the other objects (the real frame's other labels grown by %d "
@@ -696,7 +697,7 @@ std::string SensorCheckReport::FormatNeighbourhoods(
     const std::string& title, const std::vector<NeighbourhoodRow>& rows,
     const std::vector<NeighbourhoodStructure>& patterns,
     const std::vector<NeighbourhoodStructure>& real_frames,
-    const std::vector<NeighbourhoodStructure>& ir_grid_patterns) {
+    const std::vector<NeighbourhoodStructure>& other_grid_patterns) const {
   char line[200];
   std::string text = title;
   std::snprintf(line, sizeof(line), "%-24s", "");
@@ -765,9 +766,12 @@ std::string SensorCheckReport::FormatNeighbourhoods(
                   "  over real frames 1-%zu and %zu pattern%s: real mean (min-max), SL mean "
                   "(min-max), SL/real of the means%s\n",
                   real_frames.size(), patterns.size(), patterns.size() > 1 ? "s" : "",
-                  ir_grid_patterns.empty() ? ""
-                                           : "; then SL matched on the IR camera's grid and "
-                                             "registered: mean (min-max), /real");
+                  other_grid_patterns.empty() ? ""
+                  : other_grid_is_ir
+                      ? "; then SL matched on the IR camera's grid and registered: mean "
+                        "(min-max), /real"
+                      : "; then SL matched on the delivered grid (the shortcut): mean (min-max), "
+                        "/real");
     text += line;
     for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
       if (!measured(statistic)) continue;
@@ -777,10 +781,10 @@ std::string SensorCheckReport::FormatNeighbourhoods(
                     statistic.label, r.mean, r.min, r.max, sl.mean, sl.min, sl.max,
                     sl.mean / r.mean);
       text += line;
-      if (!ir_grid_patterns.empty()) {
-        const ValueSpread ir = SpreadOf(statistic, ir_grid_patterns, 1.0);
-        std::snprintf(line, sizeof(line), " %8.2f (%.2f-%.2f) %8.2f", ir.mean, ir.min, ir.max,
-                      ir.mean / r.mean);
+      if (!other_grid_patterns.empty()) {
+        const ValueSpread other = SpreadOf(statistic, other_grid_patterns, 1.0);
+        std::snprintf(line, sizeof(line), " %8.2f (%.2f-%.2f) %8.2f", other.mean, other.min,
+                      other.max, other.mean / r.mean);
         text += line;
       }
       text += "\n";
@@ -884,12 +888,14 @@ nlohmann::json SensorCheckReport::ToJson() const {
     result["like_for_like_away_patterns"] = over_patterns(like_for_like_away, pattern_away);
   }
   if (!view_temporal.empty()) result["view_temporal_correlation"] = temporal_rows(view_temporal);
-  if (real_near.size() > 1 && !pattern_near_ir_grid.empty()) {
-    result["like_for_like_ir_grid_real_frames"] =
-        over_real_frames(like_for_like, real_near, pattern_near_ir_grid);
+  if (real_near.size() > 1 && !pattern_near_other_grid.empty()) {
+    result["like_for_like_other_grid_real_frames"] =
+        over_real_frames(like_for_like, real_near, pattern_near_other_grid);
   }
-  if (!pattern_near_ir_grid.empty()) {
-    result["like_for_like_ir_grid_patterns"] = over_patterns(like_for_like, pattern_near_ir_grid);
+  if (!pattern_near_other_grid.empty()) {
+    result["like_for_like_other_grid_patterns"] =
+        over_patterns(like_for_like, pattern_near_other_grid);
+    result["other_grid"] = other_grid_is_ir ? "ir" : "delivered";
   }
   if (real_near.size() > 1 && !pattern_near.empty()) {
     result["like_for_like_real_frames"] = over_real_frames(like_for_like, real_near, pattern_near);

@@ -143,11 +143,13 @@ struct SensorCheckReport {
   // other objects (the latter empty without RealView::others).
   std::vector<uint64_t> pattern_seeds;
   std::vector<NeighbourhoodStructure> pattern_near, pattern_away;
-  // The same near the object with the IR image matched on the IR camera's own grid and the depth
-  // registered to the colour camera as the device's driver does (RegisterDepth, the exact
-  // footprint), per pattern: what the model's shortcut, matching on the delivered grid, changes at
-  // the object's outline (docs/sensor.md, "Matched on the IR camera's grid").
-  std::vector<NeighbourhoodStructure> pattern_near_ir_grid;
+  // The same near the object with the IR image matched on the other grid than the config's
+  // (StructuredLightOptions::match_on_ir_grid), per pattern: on the IR camera's own grid with the
+  // depth registered to the colour camera as the device's driver does (RegisterDepth), or on the
+  // delivered grid (the model's shortcut); what the registration changes at the object's outline
+  // (docs/sensor.md, "Matched on the IR camera's grid"). other_grid_is_ir says which.
+  std::vector<NeighbourhoodStructure> pattern_near_other_grid;
+  bool other_grid_is_ir = true;
   // The real frames (the first is like_for_like's first row), near the object and away from the
   // other objects, in the real frame's pixels (like_for_like's first pixel_scale turns them into
   // the rendered sensor's).
@@ -169,11 +171,11 @@ struct SensorCheckReport {
   std::string Format() const;
   std::string FormatLikeForLike() const;
   std::string FormatStepLaws() const;
-  static std::string FormatNeighbourhoods(
+  std::string FormatNeighbourhoods(
       const std::string& title, const std::vector<NeighbourhoodRow>& rows,
       const std::vector<NeighbourhoodStructure>& patterns = {},
       const std::vector<NeighbourhoodStructure>& real_frames = {},
-      const std::vector<NeighbourhoodStructure>& ir_grid_patterns = {});
+      const std::vector<NeighbourhoodStructure>& other_grid_patterns = {}) const;
   // sensor_check.json: columns, rendered_frames, error_structure.
   nlohmann::json ToJson() const;
 };

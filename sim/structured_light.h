@@ -93,7 +93,7 @@ struct StructuredLightOptions {
   // camera's occlusion then comes from the registration, and the object's outline bleeds as the
   // real frames' does (docs/sensor.md, "Matched on the IR camera's grid"). Costs a second view's
   // casts.
-  bool match_on_ir_grid = false;
+  bool match_on_ir_grid = true;
 
   template <class V>
   void VisitFields(V& v) {

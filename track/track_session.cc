@@ -126,8 +126,8 @@ double SmallestWidth(const TriangleMesh& model) {
   for (double step = 2.0 * std::numbers::pi / 180; step > 1e-4 * std::numbers::pi / 180;) {
     const Eigen::Vector3d u = best.unitOrthogonal(), v = best.cross(u);
     bool moved = false;
-    for (const Eigen::Vector3d t : {Eigen::Vector3d(u), Eigen::Vector3d(-u), Eigen::Vector3d(v),
-                                    Eigen::Vector3d(-v)}) {
+    for (const Eigen::Vector3d& t :
+         {Eigen::Vector3d(u), Eigen::Vector3d(-u), Eigen::Vector3d(v), Eigen::Vector3d(-v)}) {
       const Eigen::Vector3d d = (best + std::tan(step) * t).normalized();
       const double w = width(d);
       if (w < smallest) smallest = w, best = d, moved = true;

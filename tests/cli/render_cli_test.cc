@@ -237,12 +237,14 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   EXPECT_GT(like[0]["shadow_side_bleed_px"].get<double>(), 0.1);
   EXPECT_GT(like[0]["edge_side_bleed_px"].get<double>(), 0.1);
   EXPECT_THAT(r.output, HasSubstr("bleed, shadow side [px]"));
-  // Matched on the IR camera's grid and registered (match_on_ir_grid), over the 8 patterns: the
-  // registration carries the box's outline over the wall beside it on the edge side, which the
-  // delivered-grid shortcut does not (measured 0.65 px against 0.01; real 0.76).
+  // Matched on the IR camera's grid and registered (match_on_ir_grid, the default), over the 8
+  // patterns: the registration carries the box's outline over the wall beside it on the edge
+  // side, which the delivered-grid shortcut (the other grid's column) does not (measured 0.65 px
+  // against 0.01; real 0.76).
   const nlohmann::json checked = nlohmann::json::parse(ReadBytes(dir_ / "sensor_check.json"));
-  const nlohmann::json& ir_grid = checked["like_for_like_ir_grid_patterns"]["patterns"];
-  const nlohmann::json& shortcut = checked["like_for_like_patterns"]["patterns"];
+  EXPECT_EQ(checked["other_grid"], "delivered");
+  const nlohmann::json& ir_grid = checked["like_for_like_patterns"]["patterns"];
+  const nlohmann::json& shortcut = checked["like_for_like_other_grid_patterns"]["patterns"];
   ASSERT_EQ(ir_grid.size(), 8u);
   ASSERT_EQ(shortcut.size(), 8u);
   double ir_bleed = 0, shortcut_bleed = 0;
@@ -252,9 +254,11 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   }
   EXPECT_GT(ir_bleed, 0.3);
   EXPECT_LT(shortcut_bleed, 0.1);
-  EXPECT_GT(
-      checked["like_for_like_ir_grid_real_frames"]["ratio_of_means"]["missing_share"].get<double>(),
-      0.8);
+  EXPECT_GT(checked["like_for_like_real_frames"]["ratio_of_means"]["missing_share"].get<double>(),
+            0.8);
+  EXPECT_GT(checked["like_for_like_other_grid_real_frames"]["ratio_of_means"]["missing_share"]
+                .get<double>(),
+            0.8);
   // Along the desk's edge (the committed view's desk, fitted from the real frame): the real frame
   // and both modes see the floor beyond it, the IR shadow falls on it (runs of the shadow class in
   // every row that crosses the edge, about 120) and the rendered edge lies where the real one is
@@ -303,7 +307,7 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
       const nlohmann::json& spread = over["ratio_to_real"][key];
       EXPECT_NEAR(spread["mean"].get<double>(), sum / 8, 1e-12) << table << " " << key;
       EXPECT_NEAR(spread["sd"].get<double>(), std::sqrt((sum2 - sum * sum / 8) / 7), 1e-9);
-      EXPECT_EQ(spread["min"].get<double>(), low);
+      EXPECT_NEAR(spread["min"].get<double>(), low, 1e-12);
       EXPECT_GT(spread["sd"].get<double>(), 0.0) << "the patterns differ";
     }
   }
@@ -381,11 +385,13 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // The view over time in structured light: from a still camera only the IR noise changes; moved
   // as the real camera moved, the pattern slides over the scene and the errors persist less at
   // lag 4 (measured 0.648 and 0.636; the floor beyond the desk, whose windows at 1.4 m are
-  // mostly IR noise, new in every frame, thins the difference: 0.818 and 0.756 without it).
+  // mostly IR noise, new in every frame, thins the difference: 0.818 and 0.756 without it). On
+  // the IR camera's grid (the default) the registered frame's border loses the desk and the floor:
+  // 422-510 planar windows a lag, against about 1 800 on the delivered grid.
   const nlohmann::json& view_temporal = json["view_temporal_correlation"];
   ASSERT_EQ(view_temporal.size(), 2u);
   for (const auto& row : view_temporal) {
-    for (const auto& lag : row["lags"]) EXPECT_GT(lag["windows"].get<int>(), 1000) << row.dump();
+    for (const auto& lag : row["lags"]) EXPECT_GT(lag["windows"].get<int>(), 300) << row.dump();
   }
   EXPECT_GT(view_temporal[0]["lags"][1]["rho"].get<double>(), 0.5);
   EXPECT_LT(view_temporal[1]["lags"][1]["rho"].get<double>(),

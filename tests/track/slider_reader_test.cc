@@ -57,11 +57,12 @@ INSTANTIATE_TEST_SUITE_P(HandOnProxyOrBlock, SliderReaderTest,
                                            sim::TableTopScene::Hand::kOnSlider));
 
 // On structured-light frames with the hand on the block (fingers on its left end, thumb on its
-// right), by default and matched on the IR camera's grid and registered to the colour camera
-// (sensor.structured_light.match_on_ir_grid). The block matcher spreads the fingers' depth over the
-// block's green pixels beside them, and the registration leaves a gap in the block's depth beside
-// the fingers: the row's depth test and the fill take both out. Without them
-// (fill_missing_depth = false, depth_margin large) the error is larger.
+// right), matched on the delivered grid (the shortcut) and on the IR camera's grid and registered
+// to the colour camera (sensor.structured_light.match_on_ir_grid, the default since 2026-11-30).
+// The block matcher spreads the fingers' depth over the block's green pixels beside them, and the
+// registration leaves a gap in the block's depth beside the fingers: the row's depth test and the
+// fill take both out. Without them (fill_missing_depth = false, depth_margin large) the error is
+// larger.
 class SliderReaderStructuredLightTest : public ::testing::TestWithParam<bool> {};
 
 TEST_P(SliderReaderStructuredLightTest, HandOnTheBlock) {
@@ -100,7 +101,7 @@ TEST_P(SliderReaderStructuredLightTest, HandOnTheBlock) {
   EXPECT_LT(rmse, plain_rmse);
 }
 
-INSTANTIATE_TEST_SUITE_P(DefaultOrIrGrid, SliderReaderStructuredLightTest, ::testing::Bool());
+INSTANTIATE_TEST_SUITE_P(DeliveredOrIrGrid, SliderReaderStructuredLightTest, ::testing::Bool());
 
 TEST(SliderReaderErrorsTest, MissingBlockAndBadFramesAreReported) {
   test_take::SimTake take;
