@@ -725,15 +725,18 @@ struct KinectSensor::Impl {
     }
     const Rigid3 color_T_ir = color_view.world_T_view.Inverse() * iv.world_T_view;
     std::vector<int32_t> source;
+    DepthRegistrationOptions registration;
+    registration.footprint_growth_px = options.structured_light.registration_growth_px;
     const std::vector<float> registered =
-        RegisterDepth(ir_grid_depth_m, iv.intrinsics, color_view.intrinsics, color_T_ir, {},
-                      causes ? &source : nullptr);
+        RegisterDepth(ir_grid_depth_m, iv.intrinsics, color_view.intrinsics, color_T_ir,
+                      registration, causes ? &source : nullptr);
     for (size_t p = 0; p < registered.size(); ++p) {
       depth[p] = static_cast<uint16_t>(std::lround(registered[p] / kTumDepthScale));
     }
     if (!causes) return;
     std::vector<int32_t> surface;
-    RegisterDepth(iv.current.depth, iv.intrinsics, color_view.intrinsics, color_T_ir, {}, &surface);
+    RegisterDepth(iv.current.depth, iv.intrinsics, color_view.intrinsics, color_T_ir, registration,
+                  &surface);
     for (size_t p = 0; p < registered.size(); ++p) {
       if (depth[p] != 0) {
         last_causes[p] = MissingCause::kValid;

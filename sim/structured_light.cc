@@ -63,6 +63,11 @@ void StructuredLightOptions::Validate(const std::string& prefix) const {
   if (!std::isfinite(ambiguity_ratio) || ambiguity_ratio <= 0 || ambiguity_ratio > 1) {
     ThrowBadValue(prefix + ".ambiguity_ratio", FormatNumber(ambiguity_ratio), "a ratio in (0, 1]");
   }
+  if (!std::isfinite(registration_growth_px) || registration_growth_px < 0 ||
+      registration_growth_px > 1) {
+    ThrowBadValue(prefix + ".registration_growth_px", FormatNumber(registration_growth_px),
+                  "a growth in [0, 1] px");
+  }
 }
 
 }  // namespace mmh::sim

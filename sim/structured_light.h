@@ -94,6 +94,14 @@ struct StructuredLightOptions {
   // real frames' does (docs/sensor.md, "Matched on the IR camera's grid"). Costs a second view's
   // casts.
   bool match_on_ir_grid = true;
+  // With match_on_ir_grid: each IR pixel's footprint grown by this many colour pixels on every
+  // side before the registration fills it (DepthRegistrationOptions::footprint_growth_px). Where
+  // the depth steps by one lattice value between neighbouring IR pixels their footprints part by
+  // f_colour t / (8 f_ir b) = 525 * 0.025 / (8 * 580 * 0.075) = 0.038 px at every range, and a
+  // colour pixel whose centre falls in that gap gets no depth: pinholes along the lattice's
+  // iso-depth lines that real registered frames do not show. 0.05 closes gaps of up to two
+  // lattice steps (docs/sensor.md, "Pinholes of the registration").
+  double registration_growth_px = 0.05;
 
   template <class V>
   void VisitFields(V& v) {
@@ -117,6 +125,7 @@ struct StructuredLightOptions {
     v("lattice_search", lattice_search);
     v("match_in_shadow", match_in_shadow);
     v("match_on_ir_grid", match_on_ir_grid);
+    v("registration_growth_px", registration_growth_px);
   }
   void Validate(const std::string& prefix) const;
 };

@@ -63,7 +63,7 @@ TEST(RaySceneTest, FramesAreTheSameBytesOnEveryMachineWithAvx2) {
                         Case{SensorMode::kStructuredLight, false, "structured light, colour grid",
                              "96bcea31c4137003"},
                         Case{SensorMode::kStructuredLight, true, "structured light, IR grid",
-                             "f56413dc1adfc146"}}) {
+                             "e35e4681fcc90857"}}) {
     KinectSensorOptions options = config.sensor;
     options.mode = c.mode;
     options.structured_light.match_on_ir_grid = c.ir_grid;
