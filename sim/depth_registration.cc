@@ -70,22 +70,20 @@ std::vector<float> RegisterDepth(const std::vector<float>& depth_m, const Pinhol
     // Bands of destination rows in parallel: a source row's footprint spans the same destination
     // rows at every depth, so each band visits only the source rows that reach it.
     const double su = to.fx / from.fx, sv = to.fy / from.fy;
-    tbb::parallel_for(tbb::blocked_range<int>(0, to.height, 16),
-                      [&](const tbb::blocked_range<int>& band) {
-                        for (int v = 0; v < from.height; ++v) {
-                          const double v0 = sv * (v - 0.5 - from.cy) + to.cy;
-                          const double v1 = sv * (v + 0.5 - from.cy) + to.cy;
-                          if (std::ceil(v1 + g) <= band.begin() || std::ceil(v0 - g) >= band.end())
-                            continue;
-                          for (int u = 0; u < from.width; ++u) {
-                            const float z = depth_m[static_cast<size_t>(v) * from.width + u];
-                            if (!internal::ValidDepth(z)) continue;
-                            const double shift = to.fx * t.x() / z + to.cx;
-                            fill(su * (u - 0.5 - from.cx) + shift, su * (u + 0.5 - from.cx) + shift,
-                                 v0, v1, z, v * from.width + u, band.begin(), band.end());
-                          }
-                        }
-                      });
+    auto fill_band = [&](const tbb::blocked_range<int>& band) {
+      for (int v = 0; v < from.height; ++v) {
+        const double v0 = sv * (v - 0.5 - from.cy) + to.cy, v1 = sv * (v + 0.5 - from.cy) + to.cy;
+        if (std::ceil(v1 + g) <= band.begin() || std::ceil(v0 - g) >= band.end()) continue;
+        for (int u = 0; u < from.width; ++u) {
+          const float z = depth_m[static_cast<size_t>(v) * from.width + u];
+          if (!internal::ValidDepth(z)) continue;
+          const double shift = to.fx * t.x() / z + to.cx;
+          fill(su * (u - 0.5 - from.cx) + shift, su * (u + 0.5 - from.cx) + shift, v0, v1, z,
+               v * from.width + u, band.begin(), band.end());
+        }
+      }
+    };
+    tbb::parallel_for(tbb::blocked_range<int>(0, to.height, 16), fill_band);
   }
   for (int v = 0; v < from.height && !side_by_side; ++v) {
     for (int u = 0; u < from.width; ++u) {

@@ -724,12 +724,10 @@ struct KinectSensor::Impl {
       ir_grid_depth_m[p] = static_cast<float>(ir_grid_depth[p] * kTumDepthScale);
     }
     const Rigid3 color_T_ir = color_view.world_T_view.Inverse() * iv.world_T_view;
-    std::vector<int32_t> source;
     DepthRegistrationOptions registration;
     registration.footprint_growth_px = options.structured_light.registration_growth_px;
-    const std::vector<float> registered =
-        RegisterDepth(ir_grid_depth_m, iv.intrinsics, color_view.intrinsics, color_T_ir,
-                      registration, causes ? &source : nullptr);
+    const std::vector<float> registered = RegisterDepth(
+        ir_grid_depth_m, iv.intrinsics, color_view.intrinsics, color_T_ir, registration);
     for (size_t p = 0; p < registered.size(); ++p) {
       depth[p] = static_cast<uint16_t>(std::lround(registered[p] / kTumDepthScale));
     }
