@@ -115,6 +115,12 @@ std::uint64_t DeriveSeed(const Replicates& replicates, const std::string& point_
   return SplitMix64(state) & 0x7fffffffull;
 }
 
+std::uint64_t ReplicateKeySeed(std::uint64_t seed, std::size_t key_index) {
+  if (key_index == 0) return seed;
+  std::uint64_t state = seed * 0x9e3779b97f4a7c15ull + key_index;
+  return SplitMix64(state) & 0x7fffffffull;
+}
+
 std::vector<std::vector<double>> SamplePoints(const SampleSet& samples) {
   const int n = samples.count;
   const std::size_t d = samples.axes.size();
@@ -203,7 +209,7 @@ class AxisChecker {
         CheckValue(axis.key, axis.integer ? json(static_cast<long long>(std::round(v))) : json(v));
       }
     }
-    if (!spec_.replicates.seed_key.empty()) CheckKey(spec_.replicates.seed_key);
+    for (const std::string& key : spec_.replicates.seed_keys) CheckKey(key);
   }
 
  private:
@@ -287,7 +293,9 @@ Cell MakeCell(const Plan& plan, const Config& base, const Point& point, int p, i
   for (const auto& [k, v] : point) config.Set(Assignment(k, v));
   if (seeded) {
     cell.seed = DeriveSeed(spec.replicates, point_key.dump(), r);
-    config.Set(Assignment(spec.replicates.seed_key, *cell.seed));
+    for (std::size_t k = 0; k < spec.replicates.seed_keys.size(); ++k) {
+      config.Set(Assignment(spec.replicates.seed_keys[k], ReplicateKeySeed(*cell.seed, k)));
+    }
   }
   json resolved;
   try {
@@ -308,8 +316,7 @@ Cell MakeCell(const Plan& plan, const Config& base, const Point& point, int p, i
 // Every replicate of every setting, refusing two cells with one identity.
 void AddCells(const Config& base, const std::vector<Point>& points, Plan* plan) {
   const SweepSpec& spec = plan->spec;
-  const bool seeded = !spec.replicates.seed_key.empty() &&
-                      (spec.replicates.count > 1 || spec.replicates.scheme == SeedScheme::kPerCell);
+  const bool seeded = Seeded(spec.replicates);
   std::map<std::string, std::size_t> ids;
   for (std::size_t p = 0; p < points.size(); ++p) {
     for (int r = 0; r < spec.replicates.count; ++r) {

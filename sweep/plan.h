@@ -60,8 +60,12 @@ const nlohmann::json* FindKey(const nlohmann::json& root, const std::string& key
 // FNV-1a 64 of `text` as 16 hex digits.
 std::string HashHex(const std::string& text);
 
-// The derived seed of a cell (sweep/spec.h SeedScheme).
+// The derived seed of a cell (sweep/spec.h SeedScheme): its first seed key's.
 std::uint64_t DeriveSeed(const Replicates& replicates, const std::string& point_key, int replicate);
+
+// The seed of the cell's seed key number `key_index` (Replicates::seed_keys) from its derived
+// seed: the seed itself for the first key, another SplitMix64 draw for each further one (31 bits).
+std::uint64_t ReplicateKeySeed(std::uint64_t seed, std::size_t key_index);
 
 // The sample points of a sample set: count rows of axes.size() values in [from, to].
 std::vector<std::vector<double>> SamplePoints(const SampleSet& samples);

@@ -281,30 +281,48 @@ class VariedKeys {
   std::set<std::string> keys_;
 };
 
-// The replicates; run and study cells are seeded through population.seed unless the spec names
-// another key.
+// The replicates; run cells are seeded through population.seed, study cells through
+// population.seed and study.seed, unless the spec names its own keys (seed_key: a key or a list).
 void ReadReplicates(const SpecObject& o, const std::string& file, VariedKeys* keys,
                     SweepSpec* spec) {
   Replicates& replicates = spec->replicates;
+  bool named = false;
   if (o.Has("replicates")) {
     const SpecObject r(o.At("replicates"), "replicates", file, {"count", "seed_key", "seeds", "seed"});
     replicates.count = static_cast<int>(r.Integer("count", 1, 1, 100000));
-    replicates.seed_key = r.String("seed_key", "");
+    if (r.Has("seed_key")) {
+      named = true;
+      const json& key = r.At("seed_key");
+      if (key.is_string() && !key.get<std::string>().empty()) {
+        replicates.seed_keys = {key.get<std::string>()};
+      } else if (key.is_array() && !key.empty()) {
+        for (const json& k : key) {
+          if (!k.is_string() || k.get<std::string>().empty()) {
+            r.Fail("seed_key", key, "a config key or a non-empty list of config keys");
+          }
+          replicates.seed_keys.push_back(k.get<std::string>());
+        }
+      } else {
+        r.Fail("seed_key", key, "a config key or a non-empty list of config keys");
+      }
+    }
     replicates.scheme = r.Choice("seeds", SeedScheme::kPerCell,
                                  {{SeedScheme::kPerCell, "per_cell"},
                                   {SeedScheme::kCommon, "common"}});
     replicates.seed = static_cast<std::uint64_t>(r.Integer("seed", 1, 0, (1ll << 53)));
-    if (!replicates.seed_key.empty()) keys->Add(replicates.seed_key, "replicates.seed_key");
   }
-  if (replicates.seed_key.empty() &&
-      (spec->command == SweepCommand::kRun || spec->command == SweepCommand::kStudy)) {
-    replicates.seed_key = "population.seed";
-    if (replicates.count > 1) keys->Add(replicates.seed_key, "replicates.seed_key");
+  if (!named && spec->command == SweepCommand::kRun) replicates.seed_keys = {"population.seed"};
+  if (!named && spec->command == SweepCommand::kStudy) {
+    replicates.seed_keys = {"population.seed", "study.seed"};
   }
-  if (replicates.count > 1 && replicates.seed_key.empty()) {
+  if (replicates.count > 1 && replicates.seed_keys.empty()) {
     ThrowBadValue(file + ": replicates.count", std::to_string(replicates.count),
                   "1 for `mmh " + std::string(CommandName(spec->command)) +
                       "` (it has no seed; or name one in replicates.seed_key)");
+  }
+  // A seeded key is set in every cell (Seeded), so an axis on it would be overwritten.
+  if (Seeded(replicates)) {
+    for (const std::string& key : replicates.seed_keys) keys->Add(key, "replicates.seed_key");
   }
 }
 

@@ -53,10 +53,22 @@ enum class SeedScheme {
 
 struct Replicates {
   int count = 1;
-  std::string seed_key;  // config key of the seed ("" when count is 1 and the command has none)
+  // Config keys each replicate's seeds go to (empty when count is 1 and the command has none):
+  // the first gets the derived seed, each further key a seed derived from it
+  // (ReplicateKeySeed). By default run seeds population.seed, and study population.seed and
+  // study.seed (new people and new scorers, as StudyConfig::ForReplicate does): a study replicate
+  // that kept study.seed would share its scorers' design, tastes and judgement noise with every
+  // other cell.
+  std::vector<std::string> seed_keys;
   SeedScheme scheme = SeedScheme::kPerCell;
   std::uint64_t seed = 1;  // mixed into every derived seed
 };
+
+// Whether the cells set seed_keys: with several replicates, or one per cell under kPerCell.
+inline bool Seeded(const Replicates& replicates) {
+  return !replicates.seed_keys.empty() &&
+         (replicates.count > 1 || replicates.scheme == SeedScheme::kPerCell);
+}
 
 enum class Statistic { kMean, kSd, kCi95, kMin, kMax, kMedian };
 const char* StatisticName(Statistic statistic);

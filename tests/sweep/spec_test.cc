@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "sweep/plan.h"
 #include "tests/test_util.h"
@@ -75,7 +77,45 @@ TEST(SweepSpecTest, ReplicatesNeedASeedForCommandsWithoutOne) {
   const std::string e = ErrorOf([&] { ParseSpec(j, "x.json"); });
   EXPECT_NE(e.find("replicates.count"), std::string::npos) << e;
   j["command"] = "run";
-  EXPECT_EQ(ParseSpec(j, "x.json").replicates.seed_key, "population.seed");
+  EXPECT_EQ(ParseSpec(j, "x.json").replicates.seed_keys,
+            std::vector<std::string>{"population.seed"});
+}
+
+TEST(SweepSpecTest, StudyReplicatesDrawNewPeopleAndNewScorers) {
+  // A study's replicate seeds both its people and its scorers by default (as
+  // StudyConfig::ForReplicate): cells that kept study.seed would share the scorers' design,
+  // tastes and judgement noise, and with it any take-order effect that draw carries.
+  json j = Minimal();
+  j["command"] = "study";
+  j["replicates"] = {{"count", 3}};
+  EXPECT_EQ(ParseSpec(j, "x.json").replicates.seed_keys,
+            (std::vector<std::string>{"population.seed", "study.seed"}));
+  // Named keys: one, or a list; nothing else.
+  j["replicates"]["seed_key"] = "population.seed";
+  EXPECT_EQ(ParseSpec(j, "x.json").replicates.seed_keys,
+            std::vector<std::string>{"population.seed"});
+  j["replicates"]["seed_key"] = json::array({"study.seed", "population.seed"});
+  EXPECT_EQ(ParseSpec(j, "x.json").replicates.seed_keys,
+            (std::vector<std::string>{"study.seed", "population.seed"}));
+  for (const json& bad : {json::array(), json(3), json::array({"study.seed", ""}), json("")}) {
+    j["replicates"]["seed_key"] = bad;
+    const std::string e = ErrorOf([&] { ParseSpec(j, "x.json"); });
+    EXPECT_NE(e.find("x.json: replicates.seed_key"), std::string::npos) << e;
+    EXPECT_NE(e.find("a config key or a non-empty list of config keys"), std::string::npos) << e;
+  }
+  // An axis on a seeded key would be overwritten in every cell: an error naming both.
+  j["replicates"].erase("seed_key");
+  j["axes"] = json::array({{{"key", "study.seed"}, {"values", {1, 2}}}});
+  std::string e = ErrorOf([&] { ParseSpec(j, "x.json"); });
+  EXPECT_NE(e.find("replicates.seed_key"), std::string::npos) << e;
+  EXPECT_NE(e.find("each config key on one axis only"), std::string::npos) << e;
+  // Also with one replicate: each cell still gets its own seed (per_cell).
+  j["replicates"] = {{"count", 1}};
+  e = ErrorOf([&] { ParseSpec(j, "x.json"); });
+  EXPECT_NE(e.find("each config key on one axis only"), std::string::npos) << e;
+  // With common seeds and one replicate nothing is seeded, so the axis may set it.
+  j["replicates"] = {{"count", 1}, {"seeds", "common"}};
+  EXPECT_FALSE(Seeded(ParseSpec(j, "x.json").replicates));
 }
 
 TEST(SweepSpecTest, RangesHitBothEndsExactly) {
@@ -132,6 +172,19 @@ TEST(SweepSpecTest, DerivedSeedsDifferPerCellUnlessCommon) {
   r.scheme = SeedScheme::kCommon;
   EXPECT_EQ(DeriveSeed(r, "[1]", 1), DeriveSeed(r, "[2]", 1));
   EXPECT_LT(DeriveSeed(r, "[1]", 1), 1ull << 31);
+}
+
+TEST(SweepSpecTest, EachSeedKeyGetsItsOwnSeedTheFirstTheDerivedOne) {
+  std::set<std::uint64_t> seen;
+  for (std::uint64_t seed : {0ull, 1ull, 889105769ull, (1ull << 31) - 1}) {
+    EXPECT_EQ(ReplicateKeySeed(seed, 0), seed);
+    for (std::size_t k = 1; k < 4; ++k) {
+      const std::uint64_t s = ReplicateKeySeed(seed, k);
+      EXPECT_LT(s, 1ull << 31);
+      EXPECT_NE(s, seed);
+      EXPECT_TRUE(seen.insert(s).second) << seed << " " << k;
+    }
+  }
 }
 
 }  // namespace
