@@ -1,6 +1,7 @@
 #include "sweep/spec.h"
 
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "core/config.h"
@@ -271,14 +272,16 @@ class VariedKeys {
  public:
   explicit VariedKeys(const std::string& file) : file_(file) {}
   void Add(const std::string& key, const std::string& where) {
-    if (!keys_.insert(key).second) {
-      ThrowBadValue(file_ + ": " + where, "\"" + key + "\"", "each config key on one axis only");
+    const auto [it, inserted] = keys_.emplace(key, where);
+    if (!inserted) {
+      ThrowBadValue(file_ + ": " + where, "\"" + key + "\"",
+                    "each config key on one axis only (" + it->second + " varies it too)");
     }
   }
 
  private:
   const std::string& file_;
-  std::set<std::string> keys_;
+  std::map<std::string, std::string> keys_;  // key -> where it is varied
 };
 
 // The replicates; run cells are seeded through population.seed, study cells through
