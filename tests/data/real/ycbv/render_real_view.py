@@ -28,9 +28,18 @@ defaults but the proxy's, a matte printed box) and table_T_proxy.tum:
                    --desk-size whose front edge is that line), table_height, no tape (the real
                    scene has none: tape_thickness 0, a 0.1 m play area that stays on the desk) and
                    no wall (the floor beyond the desk, as in the real frame). Needs numpy.
+  --clutter DEPTH_PNG LABEL_PNG MESH ALBEDO SPECULARITY  meshes what stands on the desk in that real
+                   frame besides its labelled objects (a keyboard, a mouse, a monitor's bezel) into
+                   MESH (OBJ, table frame) and places it as the static scene object `clutter` with
+                   that IR material: the pixels more than 12 mm above the desk (the table fit's
+                   top) and off the labels grown by 6 px, their holes closed, parts of 400 pixels
+                   or more, grown 4 px into the desk; the 7 x 7 median then the 9 x 9 mean of the
+                   depth; a node every --clutter-step pixels; walls down to the desk but along the
+                   image border and where the frame sees past them. Needs numpy.
 The camera is placed at the real camera's position in the table frame, looking at the point where
 the real optical axis meets the table, turned about its axis by the real camera's roll
-(camera.roll_deg; before 2026-11-30 the roll was left out). Standard library only, but for --desk.
+(camera.roll_deg; before 2026-11-30 the roll was left out). Standard library only, but for --desk
+and --clutter.
 """
 import argparse
 import json
@@ -65,8 +74,8 @@ def inverse(r, t):
     return rt, [-sum(rt[i][k] * t[k] for k in range(3)) for i in range(3)]
 
 
-def read_depth_png(path):
-    """A 16-bit greyscale PNG as a numpy array of rows (PNG's five row filters undone)."""
+def read_png(path, bits=16):
+    """A greyscale PNG of 8 or 16 bits as a numpy array of rows (PNG's five row filters undone)."""
     import numpy as np
     import struct
     import zlib
@@ -82,12 +91,13 @@ def read_depth_png(path):
             header = struct.unpack(">IIBBBBB", chunk)
         elif kind == b"IDAT":
             idat.append(chunk)
-    width, height, bits, colour = header[:4]
-    if bits != 16 or colour != 0 or header[6] != 0:
-        raise SystemExit(f"{path}: {bits}-bit colour type {colour} (interlace {header[6]}); "
-                         "expected a non-interlaced 16-bit greyscale depth image")
+    width, height, depth_bits, colour = header[:4]
+    if depth_bits != bits or colour != 0 or header[6] != 0:
+        raise SystemExit(f"{path}: {depth_bits}-bit colour type {colour} (interlace {header[6]}); "
+                         f"expected a non-interlaced {bits}-bit greyscale image")
     raw = zlib.decompress(b"".join(idat))
-    stride = 2 * width
+    step = bits // 8  # bytes a pixel: the Sub, Average and Paeth filters look one pixel left
+    stride = step * width
     rows = np.zeros((height, stride), np.int32)
     previous = np.zeros(stride, np.int32)
     for v in range(height):
@@ -97,12 +107,12 @@ def read_depth_png(path):
             row = line
         elif kind == 2:
             row = (line + previous) & 255
-        else:  # Sub, Average, Paeth: each byte depends on the one two bytes (one pixel) left
+        else:
             row = np.zeros(stride, np.int32)
             for u in range(stride):
-                a = row[u - 2] if u >= 2 else 0
+                a = row[u - step] if u >= step else 0
                 b = previous[u]
-                c = previous[u - 2] if u >= 2 else 0
+                c = previous[u - step] if u >= step else 0
                 if kind == 1:
                     x = a
                 elif kind == 3:
@@ -114,7 +124,12 @@ def read_depth_png(path):
                 row[u] = (line[u] + x) & 255
         rows[v] = row
         previous = row
-    return (rows[:, 0::2] << 8) | rows[:, 1::2]
+    return (rows[:, 0::2] << 8) | rows[:, 1::2] if bits == 16 else rows
+
+
+def read_depth_png(path):
+    """A 16-bit greyscale depth PNG as a numpy array of rows."""
+    return read_png(path, 16)
 
 
 def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
@@ -178,6 +193,154 @@ def fit_desk(depth_png, intrinsics, r_tc, t_tc, size):
             "backdrop": False}
 
 
+def box_mean(values, weights, radius):
+    """Per pixel, the weighted mean of values over the (2 radius + 1)^2 window (0 where no weight)."""
+    import numpy as np
+    size = 2 * radius + 1
+
+    def box(a):
+        padded = np.pad(a, radius)
+        s = np.cumsum(np.cumsum(np.pad(padded, ((1, 0), (1, 0))), 0), 1)
+        return s[size:, size:] - s[:-size, size:] - s[size:, :-size] + s[:-size, :-size]
+    total = box(weights)
+    return np.where(total > 0, box(values * weights) / np.maximum(total, 1e-12), 0.0), total
+
+
+def grow(mask, radius):
+    """The mask grown by radius pixels (a square)."""
+    import numpy as np
+    return box_mean(mask.astype(float), np.ones(mask.shape), radius)[0] > 0
+
+
+def fit_clutter(depth_png, label_png, intrinsics, r_tc, t_tc, mesh_path, step, min_height,
+                min_pixels):
+    """What stands on the desk besides the labelled objects (see --clutter), as a mesh in the table
+    frame: its visible top from the real frame's depth, walled down to the desk."""
+    import numpy as np
+    depth = read_depth_png(depth_png) / 10000.0
+    label = read_png(label_png, 8)
+    if label.shape != depth.shape:
+        raise SystemExit(f"{label_png}: {label.shape[1]}x{label.shape[0]} pixels; expected the "
+                         f"depth frame's {depth.shape[1]}x{depth.shape[0]}")
+    fx, fy, cx, cy = intrinsics
+    height, width = depth.shape
+    v, u = np.mgrid[0:height, 0:width]
+    rays = np.stack([(u - cx) / fx, (v - cy) / fy, np.ones(depth.shape)], -1)
+    r = np.array(r_tc)
+    up = (rays * depth[..., None]) @ r.T + np.array(t_tc)
+    valid = depth > 0
+    # Above the desk by more than its unevenness (up to 7 mm beside the keyboard in frame 1 of
+    # video 0000), below a monitor's height, off the labelled objects and their mixed edge pixels.
+    objects = grow(label > 0, 6)
+    seen = valid & (up[..., 2] > min_height) & (up[..., 2] < 0.5) & ~objects
+    # The clutter's own missing pixels (dark keys, its edges) closed over: a pixel belongs if it is
+    # missing and most of its 7 x 7 neighbourhood is clutter.
+    share = box_mean(seen.astype(float), np.ones(depth.shape), 3)[0]
+    region = seen | (~valid & ~objects & (share > 0.5))
+    # Connected parts (4-neighbours); parts below min_pixels (a cable's few raised pixels) dropped.
+    parent = np.arange(height * width)
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+    flat = region.ravel()
+    for a in np.flatnonzero(flat):
+        for b in (a - 1 if a % width else -1, a - width):
+            if b >= 0 and flat[b]:
+                ra, rb = find(a), find(b)
+                if ra != rb:
+                    parent[max(ra, rb)] = min(ra, rb)
+    roots = np.array([find(a) if flat[a] else -1 for a in range(height * width)])
+    ids, counts = np.unique(roots[roots >= 0], return_counts=True)
+    kept = set(ids[counts >= min_pixels].tolist())
+    region = np.isin(roots, list(kept)).reshape(depth.shape)
+    # The parts run down to the desk as the real surface does (a keyboard's front slopes): the
+    # region grown by 4 pixels into the desk's pixels beside it, so that a wall stands only where
+    # the real depth steps.
+    region |= grow(region, 4) & valid & ~objects
+    known = valid & region
+    # Each node's depth: the median of the region's depths over a 7 x 7 window (a median keeps the
+    # surface's steps), then their mean over 9 x 9 (the real frame's own noise and lattice terraces
+    # are not the scene's: rendered again through the sensor model they would count its errors
+    # twice; with the median alone the view's missing share near the gelatin box rose from 1.09 to
+    # 1.15 of the real frames'); the mean over a wider window where the 7 x 7 holds no depth.
+    windows = np.lib.stride_tricks.sliding_window_view(
+        np.pad(np.where(known, depth, np.nan).astype(np.float32), 3, constant_values=np.nan),
+        (7, 7))
+    weight = np.isfinite(windows).sum((2, 3))
+    smooth = np.zeros(depth.shape)
+    smooth[weight > 0] = np.nanmedian(windows[weight > 0], (1, 2))
+    smooth = np.where(weight > 0, box_mean(smooth, (weight > 0).astype(float), 4)[0], 0.0)
+    for radius in (6, 12, 24):
+        wider, wider_weight = box_mean(depth, known.astype(float), radius)
+        smooth = np.where(weight > 0, smooth, wider)
+        weight = np.where(weight > 0, weight, wider_weight)
+    points = (rays * smooth[..., None]) @ r.T + np.array(t_tc)
+    # The grid of every step-th pixel; a cell of four nodes in the region makes two triangles,
+    # unless it spans a depth step (two parts seen one behind the other).
+    node = region & (weight > 0)
+    node[v % step != 0] = False
+    node[u % step != 0] = False
+    index = -np.ones(depth.shape, np.int64)
+    index[node] = np.arange(node.sum())
+    vertices = [points[node]]
+    corner = index[:-step:step, :-step:step], index[:-step:step, step::step], \
+        index[step::step, step::step], index[step::step, :-step:step]
+    d = smooth[::step, ::step]
+    ds = [d[:-1, :-1], d[:-1, 1:], d[1:, 1:], d[1:, :-1]]
+    cell = np.all([c >= 0 for c in corner], 0) & \
+        (np.max(ds, 0) - np.min(ds, 0) < 0.02)
+    faces = []
+    a, b, c, e = (x[cell] for x in corner)  # clockwise in the image: top left, top right, ...
+    faces += list(zip(a, b, c)) + list(zip(a, c, e))
+    # Walls: every cell side that borders no other cell, carried straight down to the desk; not
+    # along the image's border, beyond which the clutter goes on unseen, and not where the real
+    # frame sees past the wall (a monitor's bezel floats above the desk: the desk is seen below it).
+    def seen_past(i, j):
+        for a in (0.25, 0.5, 0.75):
+            for b in (0.25, 0.75):
+                top = (1 - a) * vertices[0][i] + a * vertices[0][j]
+                point = np.array([top[0], top[1], b * top[2]])
+                x, y, z = (point - np.array(t_tc)) @ r  # camera_p = table_R_camera^T (p - t)
+                col, row = int(round(fx * x / z + cx)), int(round(fy * y / z + cy))
+                if 0 <= row < height and 0 <= col < width and depth[row, col] > z + 0.01:
+                    return True
+        return False
+    count = len(vertices[0])
+    feet = {}
+
+    def foot(i):
+        nonlocal count
+        if i not in feet:
+            p = vertices[0][i]
+            feet[i] = count
+            extra.append([p[0], p[1], 0.0])
+            count += 1
+        return feet[i]
+    extra = []
+    rows, cols = cell.shape
+    padded = np.pad(cell, 1, constant_values=True)
+    for (dr, dc, first, second) in ((-1, 0, 0, 1), (0, 1, 1, 2), (1, 0, 2, 3), (0, -1, 3, 0)):
+        border = cell & ~padded[1 + dr:1 + dr + rows, 1 + dc:1 + dc + cols]
+        for i, j in zip(corner[first][border], corner[second][border]):
+            if not seen_past(i, j):
+                faces += [(i, j, foot(j)), (i, foot(j), foot(i))]
+    vertices = np.concatenate([vertices[0], np.array(extra).reshape(-1, 3)])
+    with open(mesh_path, "w") as out:
+        out.write(f"# What stands on the desk in {os.path.basename(depth_png)} besides the objects "
+                  f"of {os.path.basename(label_png)} (render_real_view.py --clutter: "
+                  f"a node every {step} pixels, above {1000 * min_height:.0f} mm, parts of {min_pixels} pixels "
+                  "or more, walled down to the desk), table frame, metres\n")
+        for p in vertices:
+            out.write("v %.5f %.5f %.5f\n" % tuple(p))
+        for f in faces:
+            out.write("f %d %d %d\n" % (f[0] + 1, f[1] + 1, f[2] + 1))
+    print(f"clutter: {len(kept)} parts, {int(region.sum())} pixels ({int(seen.sum())} seen); "
+          f"{len(vertices)} vertices, {len(faces)} triangles -> {mesh_path}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("track_folder")
@@ -194,6 +357,12 @@ def main():
                         help="fit the desk's front edge and the floor from this real depth frame")
     parser.add_argument("--desk-size", nargs=2, type=float, default=[2.0, 1.2],
                         metavar=("WIDTH", "DEPTH"), help="the desk top's size [m]")
+    parser.add_argument("--clutter", nargs=5,
+                        metavar=("DEPTH_PNG", "LABEL_PNG", "MESH", "ALBEDO", "SPECULARITY"),
+                        help="mesh what stands on the desk in that real frame besides its labelled "
+                             "objects into MESH (OBJ) and place it as a static scene object")
+    parser.add_argument("--clutter-step", type=int, default=3,
+                        help="the clutter mesh's grid spacing [pixels of the real frame]")
     parser.add_argument("--intrinsics", nargs=4, type=float, metavar=("FX", "FY", "CX", "CY"),
                         default=[1066.778, 1067.487, 312.9869, 241.3109],
                         help="the depth frame's pinhole intrinsics (YCB-Video's colour camera)")
@@ -279,6 +448,14 @@ def main():
     }
     if args.desk:
         config["scene"].update(fit_desk(args.desk, args.intrinsics, r_tc, t_tc, args.desk_size))
+    if args.clutter:
+        depth_png, label_png, mesh, albedo, specularity = args.clutter
+        fit_clutter(depth_png, label_png, args.intrinsics, r_tc, t_tc, mesh, args.clutter_step,
+                    min_height=0.012, min_pixels=400)
+        objects.append({"name": "clutter", "mesh": os.path.relpath(mesh, args.out),
+                        "x": 0.0, "y": 0.0, "z": 0.0, "qx": 0.0, "qy": 0.0, "qz": 0.0, "qw": 1.0,
+                        "material": {"ir_albedo": float(albedo),
+                                     "specularity": float(specularity)}})
     if objects:
         config["scene"]["objects"] = objects
     name = "render.json" if args.paths else stem + ".json"
