@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iterator>
 #include <limits>
+#include <tuple>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/tum_io.h"
+#include "sim/anchor_noise.h"
 #include "sim/kinect_sensor.h"
 #include "sim/silhouette_bleed.h"
 
@@ -223,6 +226,20 @@ NeighbourhoodStructure AroundObject(const std::vector<float>& depth_m, int width
 
 // The real view rendered in both modes, and each frame's neighbourhood of the object beside the
 // real frame's (docs/sensor.md, "Like for like").
+// The exact depth on the lattice without the IR shadow, the IR camera's occlusion and the
+// missing-pixel rules: the bare geometry, as a graphics engine renders it.
+KinectSensorOptions WithoutTheSensorsHoles(KinectSensorOptions options) {
+  options.mode = SensorMode::kStatistical;
+  options.noise = false;
+  options.missing.edge_probability = 0;
+  options.missing.speckle_probability = 0;
+  options.missing.grazing_from_deg = 89;
+  options.missing.grazing_to_deg = 90;
+  options.missing.projector_shadow = false;
+  options.missing.ir_camera_occlusion = false;
+  return options;
+}
+
 void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const RenderConfig& config = view.config;
   if (config.render.trajectory.empty()) {
@@ -311,13 +328,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   // floor's pixels meet), grown as the object's mask is, the object's and the other objects'
   // neighbourhoods left out; mapped to the real grid as the other objects' mask is mapped to the
   // rendered one.
-  KinectSensorOptions bare = exact;
-  bare.missing.edge_probability = 0;
-  bare.missing.speckle_probability = 0;
-  bare.missing.grazing_from_deg = 89;
-  bare.missing.grazing_to_deg = 90;
-  bare.missing.projector_shadow = false;
-  bare.missing.ir_camera_occlusion = false;
+  const KinectSensorOptions bare = WithoutTheSensorsHoles(config.sensor);
   scene.SetFrame(Rigid3(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0, -100)), 0.0);
   KinectSensor bare_sensor(bare, &scene.scene(), scene.table_T_camera());
   const RgbdFrame bare_frame = bare_sensor.Render(0);
@@ -451,6 +462,32 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
         AroundObject(DepthMetresFromUnits(frame.depth, frame.depth_scale), width, height, mask,
                      kNeighbourhoodRadiusPx, 1.0));
   }
+  // The anchors (sim/anchor_noise.h) on the view's render without the sensor's holes (a graphics
+  // engine's depth, what they post-process: no IR shadow, no IR-camera occlusion), one noise seed
+  // per pattern of structured light; and from a still camera over the temporal lags.
+  scene.SetFrame(table_T_object, 0.0);
+  KinectSensor clean_sensor(bare, &scene.scene(), scene.table_T_camera());
+  const RgbdFrame clean_frame = clean_sensor.Render(0);
+  const std::vector<float> clean = DepthMetresFromUnits(clean_frame.depth, clean_frame.depth_scale);
+  for (const AnchorModel model : {AnchorModel::kIclNuim, AnchorModel::kSimKinect}) {
+    SensorCheckReport::AnchorRows rows{AnchorName(model), {}, {}, {}};
+    for (int k = 0; k < view.patterns; ++k) {
+      const std::vector<float> depth_m =
+          ApplyAnchorNoise(model, clean, width, height, config.sensor.seed + k, 0);
+      rows.near.push_back(AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0));
+      if (!rendered_away.empty()) {
+        rows.away.push_back(
+            AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0, rendered_away));
+      }
+      if (desk) rows.desk.push_back(analyse_desk(depth_m));
+    }
+    DepthSequence still{"view, " + rows.name + ", still", width, height, intrinsics, {}};
+    for (int k = 0; k <= std::end(kTemporalLags)[-1]; ++k) {
+      still.depth_m.push_back(ApplyAnchorNoise(model, clean, width, height, config.sensor.seed, k));
+    }
+    report.view_temporal.push_back(TemporalStructure(still.name, still));
+    report.anchors.push_back(std::move(rows));
+  }
 }
 
 }  // namespace
@@ -512,13 +549,28 @@ SensorCheckReport RunSensorCheck(const std::filesystem::path& real_frames,
   for (const SensorMode mode : {SensorMode::kStatistical, SensorMode::kStructuredLight}) {
     report.columns.push_back(RenderInMode(table_top, config, mode, frames, options, report));
   }
+  // The anchors on the demo walk's first frame rendered without the sensor's holes.
+  const KinectSensorOptions clean = WithoutTheSensorsHoles(config.sensor);
+  table_top.SetFrame(config.motion.TableTProxy(0), config.motion.SliderValue(0));
+  KinectSensor clean_sensor(clean, &table_top.scene(), table_top.table_T_camera());
+  const RgbdFrame frame = clean_sensor.Render(0);
+  const std::vector<float> clean_m = DepthMetresFromUnits(frame.depth, frame.depth_scale);
+  for (const AnchorModel model : {AnchorModel::kIclNuim, AnchorModel::kSimKinect}) {
+    report.structure_names.push_back("anchor " + AnchorName(model));
+    report.structures.push_back(AnalyseErrorStructure(
+        ApplyAnchorNoise(model, clean_m, frame.depth_intrinsics.width,
+                         frame.depth_intrinsics.height, config.sensor.seed, 0),
+        frame.depth_intrinsics.width, frame.depth_intrinsics.height, frame.depth_intrinsics,
+        config.sensor.calibration, config.sensor.axial));
+  }
   return report;
 }
 
 std::string SensorCheckReport::Format() const {
   std::string text = FormatSensorTable(columns) + "\n" +
                      FormatRealismTable(structure_names, structures, 0,
-                                        {structures.size() - 2, structures.size() - 1}) +
+                                        {structures.size() - 4, structures.size() - 3,
+                                         structures.size() - 2, structures.size() - 1}) +
                      "\n" + "structured light, first frame: " + cause_table;
   // The temporal structure: one row per sequence, rho and the windows at each lag.
   text += "\nresidual correlation with the first frame (planar windows kept in both)\n";
@@ -542,7 +594,7 @@ std::string SensorCheckReport::Format() const {
     }
   };
   add_rows(temporal);
-  if (!like_for_like.empty()) text += FormatLikeForLike();
+  if (!like_for_like.empty()) text += FormatLikeForLike() + FormatAnchors();
   if (!view_temporal.empty()) {
     text += "\nthe real view over time: residual correlation with the first frame (as above)\n";
     add_rows(view_temporal);
@@ -793,6 +845,59 @@ std::string SensorCheckReport::FormatNeighbourhoods(
   return text;
 }
 
+std::string SensorCheckReport::FormatAnchors() const {
+  if (anchors.empty() || like_for_like.empty()) return "";
+  struct Table {
+    const char* name;
+    const std::vector<NeighbourhoodStructure>* real;
+    const std::vector<NeighbourhoodStructure>* structured;
+    std::vector<NeighbourhoodStructure> SensorCheckReport::AnchorRows::*rows;
+  };
+  const Table tables[] = {
+      {"near", &real_near, &pattern_near, &SensorCheckReport::AnchorRows::near},
+      {"away", &real_away, &pattern_away, &SensorCheckReport::AnchorRows::away},
+      {"desk", &real_desk, &pattern_desk, &SensorCheckReport::AnchorRows::desk}};
+  const double real_scale = like_for_like.front().pixel_scale;
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "\nthe anchors (sim/anchor_noise.h) on the view's render without the sensor's "
+                "holes, %zu noise seeds each: mean over seeds / mean over the real frames, beside "
+                "structured light's over its patterns\n",
+                anchors.front().near.size());
+  std::string text = line;
+  std::snprintf(line, sizeof(line), "%-24s", "");
+  text += line;
+  for (const Table& table : tables) {
+    if (table.real->empty() || (anchors.front().*table.rows).empty()) continue;
+    std::snprintf(line, sizeof(line), "  %s: %8s", table.name, "SL");
+    text += line;
+    for (const AnchorRows& anchor : anchors) {
+      std::snprintf(line, sizeof(line), " %10s", anchor.name.c_str());
+      text += line;
+    }
+  }
+  text += "   goal\n";
+  for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+    std::snprintf(line, sizeof(line), "%-24s", statistic.label);
+    text += line;
+    for (const Table& table : tables) {
+      if (table.real->empty() || (anchors.front().*table.rows).empty()) continue;
+      const double real = SpreadOf(statistic, *table.real, real_scale).mean;
+      std::snprintf(line, sizeof(line), "  %*s %8.2f",
+                    static_cast<int>(std::strlen(table.name)) + 1, "",
+                    SpreadOf(statistic, *table.structured, 1.0).mean / real);
+      text += line;
+      for (const AnchorRows& anchor : anchors) {
+        std::snprintf(line, sizeof(line), " %10.2f",
+                      SpreadOf(statistic, anchor.*table.rows, 1.0).mean / real);
+        text += line;
+      }
+    }
+    text += "   0.8-1.2\n";
+  }
+  return text;
+}
+
 nlohmann::json SensorCheckReport::ToJson() const {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& c : columns) j.push_back(sim::ToJson(c));
@@ -903,6 +1008,33 @@ nlohmann::json SensorCheckReport::ToJson() const {
   if (real_away.size() > 1 && !pattern_away.empty()) {
     result["like_for_like_away_real_frames"] =
         over_real_frames(like_for_like_away, real_away, pattern_away);
+  }
+  if (!anchors.empty()) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const AnchorRows& anchor : anchors) {
+      nlohmann::json entry = {{"model", anchor.name}};
+      for (const auto& [key, rows, real] : {std::tuple{"near", &anchor.near, &real_near},
+                                            std::tuple{"away", &anchor.away, &real_away},
+                                            std::tuple{"desk_edge", &anchor.desk, &real_desk}}) {
+        if (rows->empty()) continue;
+        nlohmann::json seeds = nlohmann::json::array();
+        for (const NeighbourhoodStructure& n : *rows) {
+          seeds.push_back(neighbourhoods(std::vector<NeighbourhoodRow>{{anchor.name, 1.0, n}})[0]);
+        }
+        entry[key] = seeds;
+        if (real->size() > 1 && !like_for_like.empty()) {
+          nlohmann::json ratios = nlohmann::json::object();
+          for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
+            ratios[statistic.key] =
+                SpreadOf(statistic, *rows, 1.0).mean /
+                SpreadOf(statistic, *real, like_for_like.front().pixel_scale).mean;
+          }
+          entry[std::string(key) + "_ratio_of_means"] = ratios;
+        }
+      }
+      out.push_back(entry);
+    }
+    result["like_for_like_anchors"] = out;
   }
   auto step_law_rows = [](const std::vector<StepLawRow>& rows) {
     auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); };

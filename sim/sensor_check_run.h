@@ -167,9 +167,23 @@ struct SensorCheckReport {
   int native_view_width = 0, native_view_height = 0;
   std::vector<float> native_view_depth_m[3];
 
+  // The published noise models issue 23 names as anchors (sim/anchor_noise.h: ICL-NUIM and
+  // simkinect), applied to the exact render: the demo walk's first frame's error structure is in
+  // `structures` after the two modes ("anchor ICL-NUIM", "anchor simkinect"); with a RealView, per
+  // model and per noise seed (RealView::patterns of them: config.sensor.seed and the next ones),
+  // the view's neighbourhoods near the object, away from the other objects (empty without
+  // RealView::others) and along the desk's edge (empty without one), and the view's rows in
+  // view_temporal from a still camera.
+  struct AnchorRows {
+    std::string name;
+    std::vector<NeighbourhoodStructure> near, away, desk;
+  };
+  std::vector<AnchorRows> anchors;
+
   // The tables `mmh sensor-check` prints.
   std::string Format() const;
   std::string FormatLikeForLike() const;
+  std::string FormatAnchors() const;
   std::string FormatStepLaws() const;
   std::string FormatNeighbourhoods(
       const std::string& title, const std::vector<NeighbourhoodRow>& rows,
