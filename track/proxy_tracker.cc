@@ -164,11 +164,22 @@ ProxyTracker::Candidate ProxyTracker::Verify(const RgbdFrame& frame, const IcpRe
   const Eigen::Vector3d table_c =
       camera_T_table_->Inverse() * (camera_T_proxy * model_->center().cast<double>());
   auto text = [](double value) { return FormatNumber(std::round(value * 1e4) / 1e4); };
-  if (icp.inlier_share < o.min_inlier_share) {
-    candidate.reason = "inlier share " + text(icp.inlier_share) + " < " + text(o.min_inlier_share);
-  } else if (icp.rms > o.max_rms) {
-    candidate.reason =
-        "residual " + text(icp.rms * 1000) + " mm > " + text(o.max_rms * 1000) + " mm";
+  // Judged by the interior points when the outline is flagged (segmentation.outline_span): the
+  // same pose scored, without moving it, on the points no straddling window reaches.
+  double inlier_share = icp.inlier_share, rms = icp.rms;
+  if (!interior_.empty()) {
+    IcpOptions score_only = search_icp_;
+    score_only.max_iterations = 0;
+    const IcpResult interior =
+        AlignPointToPlane(*model_, interior_, interior_.size(), o.skin_distance, icp.proxy_T_camera,
+                          score_only, sample_matches_);
+    inlier_share = interior.inlier_share;
+    rms = interior.rms;
+  }
+  if (inlier_share < o.min_inlier_share) {
+    candidate.reason = "inlier share " + text(inlier_share) + " < " + text(o.min_inlier_share);
+  } else if (rms > o.max_rms) {
+    candidate.reason = "residual " + text(rms * 1000) + " mm > " + text(o.max_rms * 1000) + " mm";
   } else if (candidate.free_space_violation > o.max_free_space_violation) {
     candidate.reason = "free-space violation " + text(candidate.free_space_violation) + " > " +
                        text(o.max_free_space_violation);
@@ -507,10 +518,12 @@ std::optional<ProxyTracker::Candidate> ProxyTracker::DetectAmongSegments(
   int tried = 0;
   for (size_t c = 0; c < whole.component_sizes.size() && tried < o.model_segments; ++c) {
     Segmentation segment;
+    const bool flagged = whole.outline.size() == whole.points.size();
     for (size_t i = 0; i < whole.points.size(); ++i) {
       if (whole.components[i] != static_cast<int>(c)) continue;
       segment.points.push_back(whole.points[i]);
       segment.components.push_back(0);
+      if (flagged) segment.outline.push_back(whole.outline[i]);
     }
     if (static_cast<int>(segment.points.size()) < options_.verification.min_points) break;
     Eigen::AlignedBox3f box;
@@ -638,10 +651,16 @@ void ProxyTracker::PrepareData() {
   const size_t stride =
       std::max<size_t>(1, (segmentation_.points.size() + options_.verification.max_points - 1) /
                               options_.verification.max_points);
+  interior_.clear();
+  const bool flagged = segmentation_.outline.size() == segmentation_.points.size();
   for (size_t i = 0; i < segmentation_.points.size(); i += stride) {
     data_.push_back(segmentation_.points[i]);
+    if (flagged && !segmentation_.outline[i]) interior_.push_back(segmentation_.points[i]);
   }
   scored_ = data_.size();
+  if (!flagged || static_cast<int>(interior_.size()) < options_.verification.min_points) {
+    interior_.clear();
+  }
   // Skin points only within reach of the proxy (the segmented points' centroid plus the model's
   // radius and the ICP's start distance): most of the hand and forearm can never lie on the model
   // and would only cost time in every ICP iteration.
@@ -814,14 +833,17 @@ void ProxyTracker::KeepOwnSegments(const Rigid3& camera_T_proxy) {
     }
   }
   size_t kept = 0;
+  const bool flagged = segmentation_.outline.size() == segmentation_.points.size();
   for (size_t i = 0; i < segmentation_.points.size(); ++i) {
     const int c = renumbered[segmentation_.components[i]];
     if (c < 0) continue;
     segmentation_.points[kept] = segmentation_.points[i];
+    if (flagged) segmentation_.outline[kept] = segmentation_.outline[i];
     segmentation_.components[kept++] = c;
   }
   segmentation_.points.resize(kept);
   segmentation_.components.resize(kept);
+  if (flagged) segmentation_.outline.resize(kept);
   segmentation_.component_sizes = std::move(sizes);
 }
 

@@ -469,6 +469,9 @@ class ProxyTracker {
   int tracked_frames_ = 0;  // measured frames since the last loss
   // Scratch: the subsampled segmented points (the first scored_), then the skin points.
   std::vector<Eigen::Vector3f> data_;
+  // The scored points of data_ off the outline band (segmentation.outline_span; empty when off or
+  // when fewer than verification.min_points): what Verify judges a pose by.
+  std::vector<Eigen::Vector3f> interior_;
   std::vector<Eigen::Vector3f> detection_scratch_;
   // Per model sample: which data it may match (kMatchesScored | kMatchesExtra); empty: all.
   std::vector<uint8_t> sample_matches_;

@@ -16,6 +16,16 @@ namespace {
 // Whether the depths `span` px before and after pixel i along a line (`stride` 1: the row,
 // `width`: the column; `before`/`after`: the neighbours lie in the image) exist and the pixel's
 // depth lies within `tolerance` [raw units] of their mean (SegmentationOptions::window_span).
+// Whether the depths `span` px before and after pixel i along a line exist and both lie within
+// `jump` [raw units] of the pixel's (SegmentationOptions::outline_span: no depth step or hole).
+bool InsideOutline(const uint16_t* depth, size_t i, size_t offset, bool inside, float jump) {
+  if (!inside) return false;
+  const uint16_t a = depth[i - offset], b = depth[i + offset];
+  if (a == 0 || b == 0) return false;
+  return std::abs(static_cast<float>(a) - depth[i]) <= jump &&
+         std::abs(static_cast<float>(b) - depth[i]) <= jump;
+}
+
 bool FlatAcross(const uint16_t* depth, size_t i, size_t offset, bool inside, float tolerance) {
   if (!inside) return false;
   const uint16_t a = depth[i - offset], b = depth[i + offset];
@@ -62,6 +72,7 @@ void Segmenter::SetTable(const Rigid3& camera_T_table, const PinholeIntrinsics& 
 void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRect* window) {
   out->points.clear();
   out->components.clear();
+  out->outline.clear();
   out->skin_points.clear();
   out->component_sizes.clear();
   out->foreground_pixels = out->skin_pixels = out->dropped_pixels = 0;
@@ -185,6 +196,14 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
       } else {
         out->points.push_back(p);
         out->components.push_back(r);
+        if (options_.outline_span > 0) {
+          const int o = options_.outline_span;
+          const float jump = static_cast<float>(options_.outline_jump) * z * z / scale;
+          out->outline.push_back(
+              !InsideOutline(frame.depth.data(), pixel, o, x >= o && x + o < width, jump) ||
+              !InsideOutline(frame.depth.data(), pixel, static_cast<size_t>(o) * width,
+                             y >= o && y + o < height, jump));
+        }
       }
     }
   }

@@ -62,6 +62,16 @@ struct SegmentationOptions {
   // 0: every candidate is kept (the statistical sensor draws its noise per pixel).
   int window_span = 0;
   double window_tolerance = 0.004;
+  // A block matcher's outline: where the correlation window straddles the proxy's outline the
+  // match takes whichever surface dominates it, so pixels up to half a window beyond the true
+  // outline may carry the proxy's depth (a real Kinect's bleed, docs/sensor.md, "The object's
+  // outline"; more with sensor.structured_light.match_in_shadow). With outline_span > 0 every
+  // proxy candidate is flagged (Segmentation::outline, not dropped) when the depth outline_span px
+  // to either side along its row or its column is missing or more than outline_jump * z^2 [m, z in
+  // m] from its own; the tracker then judges a pose by the other points (docs/tracker.md,
+  // "Judged by the interior"). 0: no flags.
+  int outline_span = 0;
+  double outline_jump = 0.01;
 
   template <class V>
   void VisitFields(V& v) {
@@ -84,6 +94,8 @@ struct SegmentationOptions {
     v("window_margin", window_margin);
     v("window_span", window_span);
     v("window_tolerance", window_tolerance);
+    v("outline_span", outline_span);
+    v("outline_jump", outline_jump);
   }
   void Validate(const std::string& prefix) const;
 };
@@ -99,6 +111,9 @@ struct Segmentation {
   // decreasing size) and pixel index.
   std::vector<Eigen::Vector3f> points;
   std::vector<int> components;
+  // Per point, 1 where it lies on the outline band (SegmentationOptions::outline_span); empty
+  // when the option is off.
+  std::vector<uint8_t> outline;
   // Skin-coloured foreground points [m] (the hand, or skin-coloured parts of the proxy).
   std::vector<Eigen::Vector3f> skin_points;
   // Pixel counts of the kept components, largest first.

@@ -49,6 +49,10 @@ void SegmentationOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".window_span", std::to_string(window_span), "an integer in [0, 32]");
   }
   RequirePositive(window_tolerance, prefix + ".window_tolerance", "m");
+  if (outline_span < 0 || outline_span > 32) {
+    ThrowBadValue(prefix + ".outline_span", std::to_string(outline_span), "an integer in [0, 32]");
+  }
+  RequirePositive(outline_jump, prefix + ".outline_jump", "m");
   if (min_component_pixels < 1) {
     ThrowBadValue(prefix + ".min_component_pixels", std::to_string(min_component_pixels), ">= 1");
   }

@@ -305,35 +305,56 @@ TEST(ProxyTrackerTest, MarioStoryTakeKeepsTheTruthOverItsTwin) {
   EXPECT_LE(result.summary.longest_failure, 15);
 }
 
+// Over the first 60 frames of the demo walk rendered in structured light (the camera of the
+// statistical frames, 1.17 m from the play area, where these were measured), with `sensor`
+// applied to the sensor's options: the frames the default tracker loses (at least min_plain) and
+// those the tracker with `tracker` applied loses (at most max_with).
+void ExpectFewerLost(const std::function<void(sim::StructuredLightOptions&)>& sensor,
+                     const std::function<void(SegmentationOptions&)>& tracker, long min_plain,
+                     long max_with) {
+  constexpr int kFrames = 60;
+  sim::RenderConfig config = test_take::StatisticalConfig();
+  config.sensor.mode = sim::SensorMode::kStructuredLight;
+  sensor(config.sensor.structured_light);
+  auto lost = [&](const ProxyTrackerOptions& options) {
+    test_take::SimTake take(config);
+    const TakeResult result = TrackTake(take, kFrames, options);
+    return static_cast<long>(
+        std::count_if(result.frames.begin(), result.frames.end(),
+                      [](const TrackFrameResult& r) { return r.status == TrackStatus::kLost; }));
+  };
+  ProxyTrackerOptions with_option;
+  tracker(with_option.segmentation);
+  const long plain = lost({}), with = lost(with_option);
+  std::printf("lost by the default tracker %ld, with the option %ld\n", plain, with);
+  EXPECT_GE(plain, min_plain);
+  EXPECT_LE(with, max_with);
+}
+
 // Structured-light frames (docs/tracker.md, "Structured-light frames"): the depth of a pixel is
 // the disparity matched over a 9 x 9 window, so near the Soldier's edges and creases it blends
 // surfaces; those points fail the verification's inlier share and most lost frames are lost for
 // that. The first 60 frames of the demo walk rendered in that mode: with the window check
 // (segmentation.window_span) the tracker keeps a pose where without it it loses a fifth of them
-// (measured: 11 lost without, 5 with; the frames are the same bytes on every run). It does not make
-// the poses accurate (measured here: 53 % within 5 deg and 1 cm without, 35 % with; docs/tracker.md,
-// "Options for correlated depth errors"), so only the lost frames are asserted.
+// (measured: 12 lost without, 5 with; the frames are the same bytes on every run). It does not make
+// the poses accurate (measured here: 53 % within 5 deg and 1 cm without, 35 % with;
+// docs/tracker.md, "Options for correlated depth errors"), so only the lost frames are asserted.
 TEST(ProxyTrackerTest, StructuredLightWindowCheckKeepsTheTrack) {
-  constexpr int kFrames = 60;
-  // (The camera of the statistical frames, 1.17 m from the play area, where it was measured.)
   // Matched on the colour camera's grid (the default until 2026-11-30), where it was measured; on
   // the IR camera's grid (the default since) the plain tracker loses 7 of these frames.
-  sim::RenderConfig config = test_take::StatisticalConfig();
-  config.sensor.mode = sim::SensorMode::kStructuredLight;
-  config.sensor.structured_light.match_on_ir_grid = false;
-  auto lost = [](const TakeResult& result) {
-    return std::count_if(result.frames.begin(), result.frames.end(),
-                         [](const TrackFrameResult& r) { return r.status == TrackStatus::kLost; });
-  };
-  test_take::SimTake plain_take(config);
-  const TakeResult plain = TrackTake(plain_take, kFrames);
-  ProxyTrackerOptions options;
-  options.segmentation.window_span = 4;
-  test_take::SimTake checked_take(config);
-  const TakeResult checked = TrackTake(checked_take, kFrames, options);
-  std::printf("lost without the window check %td, with %td\n", lost(plain), lost(checked));
-  EXPECT_GE(lost(plain), 9);
-  EXPECT_LE(lost(checked), 7);
+  ExpectFewerLost([](sim::StructuredLightOptions& o) { o.match_on_ir_grid = false; },
+                  [](SegmentationOptions& o) { o.window_span = 4; }, 9, 7);
+}
+
+// Structured light matched in the projector's shadow (sensor.structured_light.match_in_shadow,
+// docs/sensor.md): pixels beside the proxy's outline carry its depth (bleed) and are outliers of
+// the true pose, so verifications fail by a little. Judged by the interior points
+// (segmentation.outline_span: the outline band flagged, every point still fitted) the tracker
+// keeps those frames (measured: 16 lost plainly, 1 judged by the interior; the frames are the
+// same bytes on every run).
+TEST(ProxyTrackerTest, JudgedByTheInteriorTheBleedOfMatchingInShadowLosesNoFrames) {
+  ExpectFewerLost([](sim::StructuredLightOptions& o) { o.match_in_shadow = true; },
+                  [](SegmentationOptions& o) { o.outline_span = 2; }, 10, 4);
 }
 
 // A loss keeps the last measured pose for the re-acquisition (DetectionOptions::reacquire_frames).

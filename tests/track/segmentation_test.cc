@@ -32,7 +32,7 @@ RgbdFrame TwoBlocks() {
   return frame;
 }
 
-Segmentation SegmentTwoBlocks(double max_depth_jump, int window_span = 0) {
+Segmentation SegmentTwoBlocks(double max_depth_jump, int window_span = 0, int outline_span = 0) {
   TrackSetup setup;
   setup.play_area_width = setup.play_area_depth = 1.0;
   setup.like_box_length = 0;
@@ -41,6 +41,7 @@ Segmentation SegmentTwoBlocks(double max_depth_jump, int window_span = 0) {
   options.background = false;
   options.max_depth_jump = max_depth_jump;
   options.window_span = window_span;
+  options.outline_span = outline_span;
   Segmenter segmenter(options, setup);
   // The table's z axis points at the camera: a half turn about x, its origin 1 m ahead.
   const Rigid3 camera_T_table(
@@ -89,6 +90,33 @@ TEST(SegmentationTest, WindowSpanKeepsPointsWhoseWindowIsFlat) {
     // Column u = 40 + 100 x / z: inside 22..37 or 42..57.
     const double u = 40 + 100 * p.x() / p.z();
     EXPECT_TRUE((u > 21.5 && u < 37.5) || (u > 41.5 && u < 57.5)) << u;
+  }
+}
+
+// SegmentationOptions::outline_span flags, and keeps, the points within outline_span px of a
+// depth step or hole along their row or column: with span 2 every step of the two blocks is 10 cm,
+// so all but each block's 16 x 36 pixels at least 2 px inside its outline are flagged.
+TEST(SegmentationTest, OutlineSpanFlagsTheBandAndKeepsIt) {
+  EXPECT_TRUE(SegmentTwoBlocks(0.0).outline.empty());
+  const Segmentation s = SegmentTwoBlocks(0.0, 0, 2);
+  ASSERT_EQ(s.points.size(), 40u * 40u);
+  ASSERT_EQ(s.outline.size(), s.points.size());
+  int flagged = 0;
+  for (size_t i = 0; i < s.points.size(); ++i) {
+    flagged += s.outline[i];
+    const double u = 40 + 100 * s.points[i].x() / s.points[i].z();
+    const double v = 40 + 100 * s.points[i].y() / s.points[i].z();
+    const bool inside = ((u > 21.5 && u < 37.5) || (u > 41.5 && u < 57.5)) && v > 21.5 && v < 57.5;
+    EXPECT_EQ(s.outline[i] != 0, !inside) << u << " " << v;
+  }
+  EXPECT_EQ(flagged, 40 * 40 - 2 * 16 * 36);
+  SegmentationOptions options;
+  options.outline_span = 33;
+  try {
+    options.Validate("segmentation");
+    ADD_FAILURE() << "span 33 accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("segmentation.outline_span: got 33"), std::string::npos);
   }
 }
 
