@@ -135,6 +135,37 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
     }
   }
   if (out->foreground_pixels == 0) return;
+  // The hand's depth past its colour outline (SegmentationOptions::skin_grow_px): a candidate
+  // touching a skin pixel at about its depth becomes skin, skin_grow_px times over. Each pass reads
+  // the previous pass's mask, so the result does not depend on the scan order.
+  if (options_.skin_grow_px > 0 && !skin.empty()) {
+    const float near = static_cast<float>(options_.skin_grow_depth) / scale;
+    std::vector<uint8_t> grown;
+    for (int pass = 0; pass < options_.skin_grow_px; ++pass) {
+      grown = mask_;
+      for (int my = 0; my < mh; ++my) {
+        for (int mx = 0; mx < mw; ++mx) {
+          if (mask_[static_cast<size_t>(my) * mw + mx] != 1) continue;
+          const float d = frame.depth[static_cast<size_t>(region.y0 + my * step) * width +
+                                      region.x0 + mx * step];
+          for (int dy = -1; dy <= 1 && grown[static_cast<size_t>(my) * mw + mx] == 1; ++dy) {
+            for (int dx = -1; dx <= 1; ++dx) {
+              const int ny = my + dy, nx = mx + dx;
+              if (ny < 0 || ny >= mh || nx < 0 || nx >= mw) continue;
+              if (mask_[static_cast<size_t>(ny) * mw + nx] != 2) continue;
+              const float e = frame.depth[static_cast<size_t>(region.y0 + ny * step) * width +
+                                          region.x0 + nx * step];
+              if (std::abs(e - d) <= near) {
+                grown[static_cast<size_t>(my) * mw + mx] = 2;
+                break;
+              }
+            }
+          }
+        }
+      }
+      mask_.swap(grown);
+    }
+  }
 
   // Connected components; small ones are noise (flying pixels at edges, speckle).
   std::vector<int> labels, areas;

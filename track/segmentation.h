@@ -40,6 +40,13 @@ struct SegmentationOptions {
   int skin_cr_max = 173;
   int skin_cb_min = 77;
   int skin_cb_max = 127;
+  // The hand's depth reaches past its colour outline where a block matcher's window straddles it
+  // (bleed, docs/sensor.md, "The object's outline"): those pixels carry the hand's depth and the
+  // background's colour, join the proxy's candidates and pull the detection towards the hand.
+  // With skin_grow_px > 0 a candidate touching a skin pixel (8-neighbourhood) whose depth lies
+  // within skin_grow_depth [m] of its own becomes skin, skin_grow_px times over. 0: off.
+  int skin_grow_px = 0;
+  double skin_grow_depth = 0.01;
   // Connected components (8-neighbourhood of foreground pixels) with fewer pixels are dropped.
   int min_component_pixels = 25;
   // Neighbouring pixels belong to one component only when their depths differ by at most
@@ -89,6 +96,8 @@ struct SegmentationOptions {
     v("skin_cr_max", skin_cr_max);
     v("skin_cb_min", skin_cb_min);
     v("skin_cb_max", skin_cb_max);
+    v("skin_grow_px", skin_grow_px);
+    v("skin_grow_depth", skin_grow_depth);
     v("min_component_pixels", min_component_pixels);
     v("max_depth_jump", max_depth_jump);
     v("window_margin", window_margin);

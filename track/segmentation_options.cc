@@ -53,6 +53,10 @@ void SegmentationOptions::Validate(const std::string& prefix) const {
     ThrowBadValue(prefix + ".outline_span", std::to_string(outline_span), "an integer in [0, 32]");
   }
   RequirePositive(outline_jump, prefix + ".outline_jump", "m");
+  if (skin_grow_px < 0 || skin_grow_px > 8) {
+    ThrowBadValue(prefix + ".skin_grow_px", std::to_string(skin_grow_px), "an integer in [0, 8]");
+  }
+  RequirePositive(skin_grow_depth, prefix + ".skin_grow_depth", "m");
   if (min_component_pixels < 1) {
     ThrowBadValue(prefix + ".min_component_pixels", std::to_string(min_component_pixels), ">= 1");
   }

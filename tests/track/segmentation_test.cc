@@ -120,6 +120,46 @@ TEST(SegmentationTest, OutlineSpanFlagsTheBandAndKeepsIt) {
   }
 }
 
+// SegmentationOptions::skin_grow_px: the hand's depth past its colour outline. Block A (0.9 m)
+// shows skin in its columns 20-29 and grey in 30-39 at the same depth (the bleed); block B (0.8
+// m, grey) touches A's grey at a 10 cm step. Each pass turns one more column of A's grey into
+// skin; B, at another depth, and the rest of A stay proxy candidates.
+TEST(SegmentationTest, SkinGrowsOverCandidatesAtItsDepthOnly) {
+  RgbdFrame frame = TwoBlocks();
+  frame.rgb.assign(3 * 80 * 80, 128);  // grey: Cr = Cb = 128, outside the skin box
+  for (int v = 20; v < 60; ++v) {
+    for (int u = 20; u < 30; ++u) {
+      uint8_t* p = &frame.rgb[3 * (v * 80 + u)];
+      p[0] = 224, p[1] = 172, p[2] = 140;  // Cr 157, Cb 103: skin
+    }
+  }
+  TrackSetup setup;
+  setup.play_area_width = setup.play_area_depth = 1.0;
+  setup.like_box_length = 0;
+  const Rigid3 camera_T_table(
+      Eigen::Quaterniond(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(0, 0, 1));
+  for (const int grow : {0, 1, 2}) {
+    SCOPED_TRACE("skin_grow_px " + std::to_string(grow));
+    SegmentationOptions options;
+    options.background = false;
+    options.skin_grow_px = grow;
+    Segmenter segmenter(options, setup);
+    segmenter.SetTable(camera_T_table, frame.depth_intrinsics);
+    Segmentation s;
+    segmenter.Segment(frame, &s);
+    EXPECT_EQ(s.skin_points.size(), static_cast<size_t>((10 + grow) * 40));
+    EXPECT_EQ(s.points.size(), static_cast<size_t>((30 - grow) * 40));
+    for (const Eigen::Vector3f& p : s.points) {
+      const double u = 40 + 100 * p.x() / p.z();
+      EXPECT_GT(u, 29.5 + grow) << "a grey pixel of A within reach of the skin stayed";
+    }
+  }
+  SegmentationOptions bad;
+  bad.skin_grow_px = 9;
+  EXPECT_THROW(bad.Validate("segmentation"), InputError);
+}
+
 TEST(SegmentationTest, NegativeDepthJumpIsRejected) {
   SegmentationOptions options;
   options.max_depth_jump = -0.01;
