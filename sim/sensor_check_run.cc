@@ -224,8 +224,6 @@ NeighbourhoodStructure AroundObject(const std::vector<float>& depth_m, int width
   return n;
 }
 
-// The real view rendered in both modes, and each frame's neighbourhood of the object beside the
-// real frame's (docs/sensor.md, "Like for like").
 // The exact depth on the lattice without the IR shadow, the IR camera's occlusion and the
 // missing-pixel rules: the bare geometry, as a graphics engine renders it.
 KinectSensorOptions WithoutTheSensorsHoles(KinectSensorOptions options) {
@@ -240,6 +238,8 @@ KinectSensorOptions WithoutTheSensorsHoles(KinectSensorOptions options) {
   return options;
 }
 
+// The real view rendered in both modes, and each frame's neighbourhood of the object beside the
+// real frame's (docs/sensor.md, "Like for like").
 void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const RenderConfig& config = view.config;
   if (config.render.trajectory.empty()) {
@@ -743,6 +743,14 @@ ValueSpread SpreadOf(const NeighbourhoodStatistic& statistic,
   return SpreadOfValues(values);
 }
 
+// The mean of a statistic over rendered rows (in the rendered sensor's pixels) over its mean over
+// real frames (whose pixels real_scale turns into the rendered sensor's).
+double RatioOfMeans(const NeighbourhoodStatistic& statistic,
+                    const std::vector<NeighbourhoodStructure>& rendered,
+                    const std::vector<NeighbourhoodStructure>& real, double real_scale) {
+  return SpreadOf(statistic, rendered, 1.0).mean / SpreadOf(statistic, real, real_scale).mean;
+}
+
 }  // namespace
 
 std::string SensorCheckReport::FormatNeighbourhoods(
@@ -882,14 +890,13 @@ std::string SensorCheckReport::FormatAnchors() const {
     text += line;
     for (const Table& table : tables) {
       if (table.real->empty() || (anchors.front().*table.rows).empty()) continue;
-      const double real = SpreadOf(statistic, *table.real, real_scale).mean;
       std::snprintf(line, sizeof(line), "  %*s %8.2f",
                     static_cast<int>(std::strlen(table.name)) + 1, "",
-                    SpreadOf(statistic, *table.structured, 1.0).mean / real);
+                    RatioOfMeans(statistic, *table.structured, *table.real, real_scale));
       text += line;
       for (const AnchorRows& anchor : anchors) {
         std::snprintf(line, sizeof(line), " %10.2f",
-                      SpreadOf(statistic, anchor.*table.rows, 1.0).mean / real);
+                      RatioOfMeans(statistic, anchor.*table.rows, *table.real, real_scale));
         text += line;
       }
     }
@@ -975,8 +982,7 @@ nlohmann::json SensorCheckReport::ToJson() const {
     }
     nlohmann::json ratios = nlohmann::json::object();
     for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
-      ratios[statistic.key] = SpreadOf(statistic, patterns, 1.0).mean /
-                              SpreadOf(statistic, real_frames, real.pixel_scale).mean;
+      ratios[statistic.key] = RatioOfMeans(statistic, patterns, real_frames, real.pixel_scale);
     }
     return nlohmann::json{{"frames", per_frame}, {"ratio_of_means", ratios}};
   };
@@ -1026,8 +1032,7 @@ nlohmann::json SensorCheckReport::ToJson() const {
           nlohmann::json ratios = nlohmann::json::object();
           for (const NeighbourhoodStatistic& statistic : kNeighbourhoodStatistics) {
             ratios[statistic.key] =
-                SpreadOf(statistic, *rows, 1.0).mean /
-                SpreadOf(statistic, *real, like_for_like.front().pixel_scale).mean;
+                RatioOfMeans(statistic, *rows, *real, like_for_like.front().pixel_scale);
           }
           entry[std::string(key) + "_ratio_of_means"] = ratios;
         }

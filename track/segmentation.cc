@@ -13,9 +13,6 @@ namespace mmh::track {
 
 namespace {
 
-// Whether the depths `span` px before and after pixel i along a line (`stride` 1: the row,
-// `width`: the column; `before`/`after`: the neighbours lie in the image) exist and the pixel's
-// depth lies within `tolerance` [raw units] of their mean (SegmentationOptions::window_span).
 // Whether the depths `span` px before and after pixel i along a line exist and both lie within
 // `jump` [raw units] of the pixel's (SegmentationOptions::outline_span: no depth step or hole).
 bool InsideOutline(const uint16_t* depth, size_t i, size_t offset, bool inside, float jump) {
@@ -26,6 +23,9 @@ bool InsideOutline(const uint16_t* depth, size_t i, size_t offset, bool inside, 
          std::abs(static_cast<float>(b) - depth[i]) <= jump;
 }
 
+// Whether the depths `span` px before and after pixel i along a line (`stride` 1: the row,
+// `width`: the column; `before`/`after`: the neighbours lie in the image) exist and the pixel's
+// depth lies within `tolerance` [raw units] of their mean (SegmentationOptions::window_span).
 bool FlatAcross(const uint16_t* depth, size_t i, size_t offset, bool inside, float tolerance) {
   if (!inside) return false;
   const uint16_t a = depth[i - offset], b = depth[i + offset];
@@ -140,27 +140,30 @@ void Segmenter::Segment(const RgbdFrame& frame, Segmentation* out, const ImageRe
   // the previous pass's mask, so the result does not depend on the scan order.
   if (options_.skin_grow_px > 0 && !skin.empty()) {
     const float near = static_cast<float>(options_.skin_grow_depth) / scale;
+    auto depth_at = [&](int mx, int my) -> float {
+      return frame
+          .depth[static_cast<size_t>(region.y0 + my * step) * width + region.x0 + mx * step];
+    };
+    // Whether a skin pixel of `mask` touches (mx, my) within `near` of its depth.
+    auto touches_skin = [&](const std::vector<uint8_t>& mask, int mx, int my) {
+      const float d = depth_at(mx, my);
+      for (int ny = std::max(0, my - 1); ny <= std::min(mh - 1, my + 1); ++ny) {
+        for (int nx = std::max(0, mx - 1); nx <= std::min(mw - 1, mx + 1); ++nx) {
+          if (mask[static_cast<size_t>(ny) * mw + nx] == 2 &&
+              std::abs(depth_at(nx, ny) - d) <= near) {
+            return true;
+          }
+        }
+      }
+      return false;
+    };
     std::vector<uint8_t> grown;
     for (int pass = 0; pass < options_.skin_grow_px; ++pass) {
       grown = mask_;
       for (int my = 0; my < mh; ++my) {
         for (int mx = 0; mx < mw; ++mx) {
-          if (mask_[static_cast<size_t>(my) * mw + mx] != 1) continue;
-          const float d = frame.depth[static_cast<size_t>(region.y0 + my * step) * width +
-                                      region.x0 + mx * step];
-          for (int dy = -1; dy <= 1 && grown[static_cast<size_t>(my) * mw + mx] == 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int ny = my + dy, nx = mx + dx;
-              if (ny < 0 || ny >= mh || nx < 0 || nx >= mw) continue;
-              if (mask_[static_cast<size_t>(ny) * mw + nx] != 2) continue;
-              const float e = frame.depth[static_cast<size_t>(region.y0 + ny * step) * width +
-                                          region.x0 + nx * step];
-              if (std::abs(e - d) <= near) {
-                grown[static_cast<size_t>(my) * mw + mx] = 2;
-                break;
-              }
-            }
-          }
+          const size_t i = static_cast<size_t>(my) * mw + mx;
+          if (mask_[i] == 1 && touches_skin(mask_, mx, my)) grown[i] = 2;
         }
       }
       mask_.swap(grown);

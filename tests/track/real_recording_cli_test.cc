@@ -14,6 +14,7 @@
 
 #include "core/image_io.h"
 #include "core/tum_io.h"
+#include "metrics/tracking_metrics.h"
 #include "tests/test_util.h"
 
 namespace mmh {
@@ -175,16 +176,12 @@ TEST(RealRecordingCliTest, TheViewsClutterStandsOnTheRealFramesPixels) {
     desk_errors.push_back(std::abs(b - measured));
   }
   ASSERT_GT(errors.size(), 20000u) << "the keyboard alone covers about 30 000 pixels";
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
   const double within =
       std::count_if(errors.begin(), errors.end(), [](double e) { return e < 0.01; }) /
       static_cast<double>(errors.size());
-  EXPECT_LT(median(errors), 0.002);
+  EXPECT_LT(metrics::Quantile(errors, 0.5), 0.002);
   EXPECT_GT(within, 0.95);
-  EXPECT_GT(median(desk_errors), 0.01);
+  EXPECT_GT(metrics::Quantile(desk_errors, 0.5), 0.01);
 }
 
 TEST(RealRecordingCliTest, TracksYcbVideoObjectsFromItsOwnDetection) {
