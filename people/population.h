@@ -18,7 +18,7 @@ struct PopulationOptions {
   double skill_sd = 0.2;
   double energy_mean = 0.5;
   double energy_sd = 0.2;
-  double learning_mean = 0.148;  // calibrated (docs/calibration.md), as move_threshold_mean
+  double learning_mean = 0.124;  // calibrated (docs/calibration.md), as move_threshold_mean
   double learning_sd = 0.1;
   double style_sd = 0.2;     // log-sd of the personal style multipliers
   double delay_mean = 0.30;  // [s] reaction delay, kept within [0.25, 0.35]
@@ -32,7 +32,7 @@ struct PopulationOptions {
   double opinion_noise_sd = 0.2;
   double lapse_rate = 1.0;  // [1/min]
   // The annotators' dead band h (people/annotator.h), normal truncated at 0 [slider units].
-  double move_threshold_mean = 1.41;
+  double move_threshold_mean = 1.40;
   double move_threshold_sd = 0.0;
 
   template <class V>

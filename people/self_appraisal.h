@@ -29,8 +29,8 @@ namespace mmh::people {
 // Config section "self_appraisal".
 struct SelfAppraisalOptions {
   // Calibrated to the paper's study (docs/calibration.md).
-  double progress_weight = 0.190;  // π: utility the animator adds to their last take over the first
-  double choice_bonus = 0.152;     // c: utility the animator adds to their montage
+  double progress_weight = 0.177;  // π: utility the animator adds to their last take over the first
+  double choice_bonus = 0.177;     // c: utility the animator adds to their montage
 
   template <class V>
   void VisitFields(V& v) {

@@ -27,7 +27,7 @@ namespace mmh::people {
 
 struct ViewerOptions {
   // w_a and σ are calibrated to the paper's study (docs/calibration.md).
-  double artefact_weight = 0.0234;       // w_a: appeal lost per artefact unit per minute
+  double artefact_weight = 0.0285;       // w_a: appeal lost per artefact unit per minute
   double velocity_threshold = 0.03;      // v_0 [m/s] change of the smoothed velocity in one frame
   double angular_threshold = 0.6;        // ω_0 [rad/s] change of the smoothed angular velocity
   double contrast = 3.0;                 // k: how far above the local rhythm a change stands out
@@ -36,7 +36,7 @@ struct ViewerOptions {
   int smoothing = 5;                     // frames of the centred moving average (odd)
   double quality_weight_sd = 0.15;       // spread of b_q (mean 1) between viewers
   double artefact_sensitivity_sd = 0.3;  // log-sd of s (median 1) between viewers
-  double judgement_noise = 0.223;        // σ per viewing
+  double judgement_noise = 0.179;        // σ per viewing
 
   template <class V>
   void VisitFields(V& v) {

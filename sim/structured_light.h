@@ -84,8 +84,9 @@ struct StructuredLightOptions {
   // Match windows centred in the projector's shadow like any other, so that the correlation
   // decides (a window whose lit part correlates keeps its depth, as on the device, which does not
   // know where the shadow is; docs/sensor.md, "The step law of the bands"); false rejects them
-  // outright. Off: docs/sensor.md, "Why match_in_shadow stays off".
-  bool match_in_shadow = false;
+  // outright (the model's rule until 2026-12-01; the real desk's edge keeps depth inside the
+  // geometric shadow: docs/sensor.md, "Matching in the shadow becomes the default").
+  bool match_in_shadow = true;
   // With registered depth: render the IR image and match it on the IR camera's own grid
   // (ir_intrinsics, 2.5 cm beside the colour camera), then carry the depth to the colour camera's
   // image as the device's driver does (sim/depth_registration.h: each IR pixel's footprint, the

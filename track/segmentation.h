@@ -44,8 +44,10 @@ struct SegmentationOptions {
   // (bleed, docs/sensor.md, "The object's outline"): those pixels carry the hand's depth and the
   // background's colour, join the proxy's candidates and pull the detection towards the hand.
   // With skin_grow_px > 0 a candidate touching a skin pixel (8-neighbourhood) whose depth lies
-  // within skin_grow_depth [m] of its own becomes skin, skin_grow_px times over. 0: off.
-  int skin_grow_px = 0;
+  // within skin_grow_depth [m] of its own becomes skin, skin_grow_px times over. 0: off, for
+  // frames without bleed (sensor.mode "statistical"), where the growth only eats the proxy's
+  // pixels beside the gripping fingers (docs/tracker.md, "Judged by the interior").
+  int skin_grow_px = 1;
   double skin_grow_depth = 0.01;
   // Connected components (8-neighbourhood of foreground pixels) with fewer pixels are dropped.
   int min_component_pixels = 25;
@@ -77,7 +79,7 @@ struct SegmentationOptions {
   // to either side along its row or its column is missing or more than outline_jump * z^2 [m, z in
   // m] from its own; the tracker then judges a pose by the other points (docs/tracker.md,
   // "Judged by the interior"). 0: no flags.
-  int outline_span = 0;
+  int outline_span = 2;
   double outline_jump = 0.01;
 
   template <class V>

