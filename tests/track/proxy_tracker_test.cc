@@ -349,7 +349,7 @@ void ExpectFewerLost(const std::function<void(sim::StructuredLightOptions&)>& se
   ProxyTrackerOptions with_option = plain_options;
   tracker(with_option.segmentation);
   const long plain = lost(plain_options), with = lost(with_option);
-  std::printf("lost by the default tracker %ld, with the option %ld\n", plain, with);
+  std::printf("lost by the plain tracker %ld, with the option %ld\n", plain, with);
   EXPECT_GE(plain, min_plain);
   EXPECT_LE(with, max_with);
 }
@@ -584,14 +584,14 @@ test_take::SimTake StructuredLightStoryTake(const std::string& config_file, int 
                                         /*statistical=*/false);
 }
 
-// Two trackers, WithoutTheOutlineOptions (named "defaults", the defaults when these moments were
-// found) and with `other`, see the same first `frames` frames of `take`: per tracker the tracked
+// Two trackers, WithoutTheOutlineOptions ("plain", the defaults when these moments were found)
+// and with `other`, see the same first `frames` frames of `take`: per tracker the tracked
 // frames from `counted_from` on more than 90 deg from the truth (in a twin), and the first
 // tracker's frames whose reason contains `reason`. (With the outline band judged apart, the
 // defaults since 2026-12-01, the tracker keeps the frames whose loss starts these moments, and
 // neither tracker enters a twin.)
 struct TwinFrames {
-  int defaults = 0, other = 0, with_reason = 0;
+  int plain = 0, other = 0, with_reason = 0;
 };
 TwinFrames CountTwinFrames(test_take::SimTake& take, int frames, int counted_from,
                            const ProxyTrackerOptions& other, const std::string& reason) {
@@ -608,12 +608,12 @@ TwinFrames CountTwinFrames(test_take::SimTake& take, int frames, int counted_fro
     const TrackFrameResult ra = a.Track(frame);
     const TrackFrameResult rb = b.Track(frame);
     if (i < counted_from) continue;
-    count.defaults += flipped(ra, truth);
+    count.plain += flipped(ra, truth);
     count.other += flipped(rb, truth);
     count.with_reason += ra.reason.find(reason) != std::string::npos;
   }
-  std::printf("frames in the twin: defaults %d, other options %d; '%s' %d\n", count.defaults,
-              count.other, reason.c_str(), count.with_reason);
+  std::printf("frames in the twin: plain %d, other options %d; '%s' %d\n", count.plain, count.other,
+              reason.c_str(), count.with_reason);
   return count;
 }
 
@@ -638,7 +638,7 @@ TEST(ProxyTrackerTest, StructuredLightTrustedTrackIsHeldAgainstItsTwin) {
   const TwinFrames count = CountTwinFramesOfStoryTake("configs/soldier.json", 1, 270, 0, unheld,
                                                       "held");
   EXPECT_GE(count.with_reason, 1);
-  EXPECT_EQ(count.defaults, 0);
+  EXPECT_EQ(count.plain, 0);
   EXPECT_GE(count.other, 3);
 }
 
@@ -653,7 +653,7 @@ TEST(ProxyTrackerTest, StructuredLightReacquisitionKeepsTheTrust) {
   untrusted.detection.reacquire_trust_frames = 0;
   const TwinFrames count =
       CountTwinFramesOfStoryTake("configs/mario.json", 2, 300, 200, untrusted, "");
-  EXPECT_EQ(count.defaults, 0);
+  EXPECT_EQ(count.plain, 0);
   EXPECT_GE(count.other, 20);
 }
 
