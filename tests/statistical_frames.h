@@ -18,4 +18,13 @@ inline const std::vector<std::string>& StatisticalFrameSettings() {
   return settings;
 }
 
+// The tracker for those frames, which have no block matcher's bleed: no skin growth (the default 1
+// only turns the proxy's pixels beside the gripping fingers into skin there, and some first
+// detections tip into the half-turn twin; docs/tracker.md, "Both options on by default"). As a
+// config assignment, for `mmh track --set` and Config::Set.
+inline const std::string& StatisticalFramesTrackerSetting() {
+  static const std::string setting = "tracker.segmentation.skin_grow_px=0";
+  return setting;
+}
+
 }  // namespace mmh::test_util

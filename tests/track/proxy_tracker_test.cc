@@ -84,16 +84,13 @@ TEST(ProxyTrackerTest, DemoWalkWithHand) {
   EXPECT_GE(result.summary.success_rate, 0.99);
 }
 
-// The tracker for frames without a block matcher's bleed (sensor.mode "statistical"): no skin
-// growth (segmentation.skin_grow_px 0). There the hand's depth ends at its colour outline, and the
-// growth only turns the proxy's pixels beside the gripping fingers into skin, which tips some first
-// detections into the half-turn twin (measured with the default 1: OtherWalksPooled 98.8 % within
-// 5 deg and 1 cm, SoldierSideViewDoesNotSlideUpItsFaces 98.7 %; docs/tracker.md, "Judged by the
-// interior").
+// The tracker for statistical frames (test_util::StatisticalFramesTrackerSetting; measured with
+// the default skin growth: OtherWalksPooled 98.8 % within 5 deg and 1 cm,
+// SoldierSideViewDoesNotSlideUpItsFaces 98.7 %).
 ProxyTrackerOptions StatisticalFramesTracker() {
-  ProxyTrackerOptions options;
-  options.segmentation.skin_grow_px = 0;
-  return options;
+  Config config;
+  config.Set(test_util::StatisticalFramesTrackerSetting());
+  return config.Get<ProxyTrackerOptions>("tracker");
 }
 
 // Five more walks (other noise seeds, 6-10 s rounds, yaw swings 0.2-0.6 rad), pooled: the issue's

@@ -164,10 +164,10 @@ TEST(TrackCliTest, TableFrameOutput) {
   }
 }
 
-// The tracker for the statistical frames of RenderedTake, which have no block matcher's bleed: no
-// skin growth (with it this take's first detection verifies a pose 2.7 cm off in frame 0;
-// tests/track/proxy_tracker_test.cc, StatisticalFramesTracker).
-constexpr const char* kStatisticalFramesTracker = " --set tracker.segmentation.skin_grow_px=0";
+// The tracker for the statistical frames of RenderedTake (with the default skin growth this take's
+// first detection verifies a pose 2.7 cm off in frame 0).
+const std::string kStatisticalFramesTracker =
+    " --set " + test_util::StatisticalFramesTrackerSetting();
 
 TEST(TrackCliTest, FreenectInputRunsOnAFakenectDump) {
   const fs::path dump = RenderedTake().string() + ".fakenect";
