@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "core/simd.h"
 #include "sim/internal/depth_sample.h"
 
 namespace mmh::sim {
@@ -19,6 +20,32 @@ void DepthRegistrationOptions::Validate(const std::string& prefix) const {
                   "a finite growth of 0 px or more");
   }
 }
+
+namespace {
+
+// Cameras side by side: the destination columns [first_u[u], last_u[u]] (empty: first > last)
+// whose centres c satisfy u0 - g <= c < u1 + g for source pixel u of a row, where
+// u0 = left[u] + shift, u1 = right[u] + shift and shift = f_tx / z + cx moves a point at depth z
+// from one camera to the other; missing depths cover nothing. IEEE operations only (ceil is
+// exact), so every clone gives the same columns.
+MMH_SIMD_CLONES void FootprintColumns(const float* z_row, const double* left, const double* right,
+                                      int width, double f_tx, double cx, double g, int to_width,
+                                      int32_t* first_u, int32_t* last_u) {
+  const double last_column = to_width - 1;
+  for (int u = 0; u < width; ++u) {
+    const float z = z_row[u];
+    const bool valid = internal::ValidDepth(z);
+    const double shift = f_tx / (valid ? static_cast<double>(z) : 1.0) + cx;
+    // Clamped before the conversion to int, so that no value outside int's range is converted.
+    const double first = std::min(std::max(std::ceil((left[u] + shift) - g), 0.0), last_column + 1);
+    const double last =
+        std::max(std::min(std::ceil((right[u] + shift) + g) - 1, last_column), -1.0);
+    first_u[u] = valid ? static_cast<int32_t>(first) : 1;
+    last_u[u] = valid ? static_cast<int32_t>(last) : 0;
+  }
+}
+
+}  // namespace
 
 std::vector<float> RegisterDepth(const std::vector<float>& depth_m, const PinholeIntrinsics& from,
                                  const PinholeIntrinsics& to, const Rigid3& to_T_from,
@@ -68,18 +95,39 @@ std::vector<float> RegisterDepth(const std::vector<float>& depth_m, const Pinhol
                             std::abs(t.y()) < 1e-12 && std::abs(t.z()) < 1e-12;
   if (side_by_side) {
     // Bands of destination rows in parallel: a source row's footprint spans the same destination
-    // rows at every depth, so each band visits only the source rows that reach it.
+    // rows at every depth, so each band visits only the source rows that reach it. Per source
+    // row the columns each footprint covers are found first (FootprintColumns, vectorised), then
+    // filled row by row: a destination pixel still sees its sources in index order.
     const double su = to.fx / from.fx, sv = to.fy / from.fy;
+    std::vector<double> left(from.width), right(from.width);
+    for (int u = 0; u < from.width; ++u) {
+      left[u] = su * (u - 0.5 - from.cx);
+      right[u] = su * (u + 0.5 - from.cx);
+    }
+    const double f_tx = to.fx * t.x();
     auto fill_band = [&](const tbb::blocked_range<int>& band) {
+      std::vector<int32_t> first_u(from.width), last_u(from.width);
       for (int v = 0; v < from.height; ++v) {
         const double v0 = sv * (v - 0.5 - from.cy) + to.cy, v1 = sv * (v + 0.5 - from.cy) + to.cy;
         if (std::ceil(v1 + g) <= band.begin() || std::ceil(v0 - g) >= band.end()) continue;
-        for (int u = 0; u < from.width; ++u) {
-          const float z = depth_m[static_cast<size_t>(v) * from.width + u];
-          if (!internal::ValidDepth(z)) continue;
-          const double shift = to.fx * t.x() / z + to.cx;
-          fill(su * (u - 0.5 - from.cx) + shift, su * (u + 0.5 - from.cx) + shift, v0, v1, z,
-               v * from.width + u, band.begin(), band.end());
+        const int first_v = std::max(band.begin(), static_cast<int>(std::ceil(v0 - g)));
+        const int last_v = std::min(band.end() - 1, static_cast<int>(std::ceil(v1 + g)) - 1);
+        const float* row = depth_m.data() + static_cast<size_t>(v) * from.width;
+        FootprintColumns(row, left.data(), right.data(), from.width, f_tx, to.cx, g, to.width,
+                         first_u.data(), last_u.data());
+        for (int y = first_v; y <= last_v; ++y) {
+          float* out_row = out.data() + static_cast<size_t>(y) * to.width;
+          int32_t* source_row =
+              source != nullptr ? source->data() + static_cast<size_t>(y) * to.width : nullptr;
+          for (int u = 0; u < from.width; ++u) {
+            const float z = row[u];
+            for (int x = first_u[u]; x <= last_u[u]; ++x) {
+              if (z < out_row[x]) {
+                out_row[x] = z;
+                if (source_row != nullptr) source_row[x] = v * from.width + u;
+              }
+            }
+          }
         }
       }
     };

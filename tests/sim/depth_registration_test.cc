@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "core/error.h"
@@ -118,7 +119,9 @@ TEST(DepthRegistration, TheSideBySideShortcutAgreesWithTheGeneralProjection) {
   int differ = 0;
   for (size_t p = 0; p < a.size(); ++p) {
     differ += a_source[p] != b_source[p];
-    if (a_source[p] == b_source[p] && a[p] != 0) EXPECT_NEAR(a[p], b[p], 1e-5);
+    if (a_source[p] == b_source[p] && a[p] != 0) {
+      EXPECT_NEAR(a[p], b[p], 1e-5);
+    }
   }
   EXPECT_LT(differ, static_cast<int>(a.size() / 200)) << differ;
   // A plane turned by 2 degrees about the vertical stays whole inside.
@@ -128,6 +131,60 @@ TEST(DepthRegistration, TheSideBySideShortcutAgreesWithTheGeneralProjection) {
       RegisterDepth(std::vector<float>(depth.size(), 1.0f), from, from, turn);
   for (int v = 10; v < from.height - 10; ++v) {
     for (int u = 20; u < from.width - 20; ++u) EXPECT_GT(plane[v * from.width + u], 0) << u;
+  }
+}
+
+// The side-by-side shortcut against brute force: every destination centre tested against every
+// source pixel's footprint, u0 - g <= x < u1 + g and v0 - g <= y < v1 + g with the footprint's
+// edges computed as the documented formula does, the nearest depth winning and ties the lowest
+// source index. Random depths with holes (0 and NaN), runs of equal depths (ties) and near
+// surfaces, onto a coarser and a finer grid, with and without growth.
+TEST(DepthRegistration, TheSideBySideShortcutEqualsBruteForce) {
+  std::mt19937 random(23);
+  std::uniform_real_distribution<float> depth_of(0.45f, 3.0f);
+  std::uniform_int_distribution<int> kind(0, 9);
+  for (const double to_f : {52.7, 61.0, 118.3}) {
+    for (const double g : {0.0, 0.05, 0.6}) {
+      const PinholeIntrinsics from = Intrinsics(58.1, 40, 30), to = Intrinsics(to_f, 48, 36);
+      std::vector<float> depth(from.width * from.height);
+      for (float& z : depth) {
+        const int k = kind(random);
+        z = k == 0 ? 0.0f : k == 1 ? std::nanf("") : k < 4 ? 1.25f : depth_of(random);
+      }
+      const Rigid3 to_T_from = Beside(-0.025);
+      DepthRegistrationOptions options;
+      options.footprint_growth_px = g;
+      std::vector<int32_t> source;
+      const std::vector<float> out = RegisterDepth(depth, from, to, to_T_from, options, &source);
+      const double su = to.fx / from.fx, sv = to.fy / from.fy;
+      for (int y = 0; y < to.height; ++y) {
+        for (int x = 0; x < to.width; ++x) {
+          float best = 0;
+          int32_t best_index = -1;
+          for (int v = 0; v < from.height; ++v) {
+            const double v0 = sv * (v - 0.5 - from.cy) + to.cy,
+                         v1 = sv * (v + 0.5 - from.cy) + to.cy;
+            if (!(v0 - g <= y && y < v1 + g)) continue;
+            for (int u = 0; u < from.width; ++u) {
+              const float z = depth[v * from.width + u];
+              if (!(std::isfinite(z) && z > 0)) continue;
+              const double shift = to.fx * to_T_from.translation.x() / z + to.cx;
+              const double u0 = su * (u - 0.5 - from.cx) + shift,
+                           u1 = su * (u + 0.5 - from.cx) + shift;
+              if (!(u0 - g <= x && x < u1 + g)) continue;
+              if (best_index < 0 || z < best) {
+                best = z;
+                best_index = v * from.width + u;
+              }
+            }
+          }
+          const size_t p = static_cast<size_t>(y) * to.width + x;
+          ASSERT_EQ(source[p], best_index)
+              << "f " << to_f << ", g " << g << ", x " << x << ", y " << y;
+          ASSERT_EQ(out[p], best) << x << ", " << y;
+        }
+      }
+    }
   }
 }
 
