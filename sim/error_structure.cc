@@ -228,6 +228,44 @@ std::vector<uint8_t> GrowMask(std::span<const uint8_t> mask, int width, int heig
   return region;
 }
 
+void MissingInside(const std::vector<float>& depth_m, int width, int height,
+                   std::span<const uint8_t> mask, int radius_px, std::span<const uint8_t> excluded,
+                   NeighbourhoodStructure& n) {
+  const size_t pixels = static_cast<size_t>(width) * height;
+  if (depth_m.size() != pixels || mask.size() != pixels ||
+      (!excluded.empty() && excluded.size() != pixels)) {
+    ThrowBadValue("mask",
+                  std::to_string(mask.size()) + " pixels, " + std::to_string(excluded.size()) +
+                      " excluded and " + std::to_string(depth_m.size()) + " depths",
+                  std::to_string(pixels) + " of each (none excluded: 0)");
+  }
+  // Shrinking the mask is growing its complement; beyond the image counts as outside, so a pixel
+  // within radius_px of the image's side is not interior.
+  const int pad = radius_px;
+  const int padded_width = width + 2 * pad, padded_height = height + 2 * pad;
+  std::vector<uint8_t> outside(static_cast<size_t>(padded_width) * padded_height, 1);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      outside[static_cast<size_t>(v + pad) * padded_width + u + pad] =
+          mask[static_cast<size_t>(v) * width + u] == 0;
+    }
+  }
+  const std::vector<uint8_t> near_outside =
+      GrowMask(outside, padded_width, padded_height, radius_px);
+  double inside = 0, missing = 0;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t p = static_cast<size_t>(v) * width + u;
+      if (near_outside[static_cast<size_t>(v + pad) * padded_width + u + pad] != 0) continue;
+      if (!excluded.empty() && excluded[p] != 0) continue;
+      inside += 1;
+      if (!ValidDepth(depth_m[p])) missing += 1;
+    }
+  }
+  n.interior_pixels = inside;
+  n.interior_missing_share = inside > 0 ? missing / inside : kNaN;
+}
+
 NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, int width,
                                             int height, std::span<const uint8_t> mask,
                                             int radius_px, const ErrorStructureOptions& options,

@@ -139,6 +139,11 @@ struct NeighbourhoodStructure {
   double shadow_side_erosion_px = std::numeric_limits<double>::quiet_NaN();
   double edge_side_erosion_px = std::numeric_limits<double>::quiet_NaN();
   int shadow_side_ends = 0, edge_side_ends = 0;  // the silhouette's ends measured
+  // The object's interior (MissingInside: its mask shrunk by the caller's radius), where the mask
+  // is an object's: its pixels and the share of them missing (NaN otherwise), the holes on the
+  // surface itself, clear of the bands at its outline.
+  double interior_pixels = 0;
+  double interior_missing_share = std::numeric_limits<double>::quiet_NaN();
 };
 // `excluded` (empty, or width x height, non-zero = left out): pixels taken out of the
 // neighbourhood, and runs with a pixel there not counted: the parts of a real frame near objects
@@ -152,6 +157,13 @@ NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, i
 // The mask (width x height, non-zero = in) grown by radius_px pixels: a square of side
 // 2 radius_px + 1 around each pixel in it (Chebyshev distance). Returns 0 / 1 per pixel.
 std::vector<uint8_t> GrowMask(std::span<const uint8_t> mask, int width, int height, int radius_px);
+
+// The mask's interior: the pixels whose whole square of side 2 radius_px + 1 lies in the mask
+// (and in the image), `excluded` (empty, or non-zero = left out) taken out; sets
+// interior_pixels and interior_missing_share of `n` (NaN: no interior pixel).
+void MissingInside(const std::vector<float>& depth_m, int width, int height,
+                   std::span<const uint8_t> mask, int radius_px, std::span<const uint8_t> excluded,
+                   NeighbourhoodStructure& n);
 
 // The classes against a rendered frame's exact causes (KinectSensor::missing_causes), in % of all
 // pixels: how well the depth-image rules that classify real frames name the sensor's causes.

@@ -221,6 +221,7 @@ NeighbourhoodStructure AroundObject(const std::vector<float>& depth_m, int width
   n.edge_side_erosion_px = bleed.edge_side.erosion_px;
   n.shadow_side_ends = bleed.shadow_side.ends;
   n.edge_side_ends = bleed.edge_side.ends;
+  MissingInside(depth_m, width, height, mask, in_frame(kInteriorErosionPx), excluded, n);
   return n;
 }
 
@@ -690,6 +691,8 @@ struct NeighbourhoodStatistic {
 constexpr NeighbourhoodStatistic kNeighbourhoodStatistics[] = {
     {"missing [%]", "missing_share",
      [](const NeighbourhoodStructure& n, double) { return 100 * n.missing_share; }},
+    {"missing inside [%]", "interior_missing_share",
+     [](const NeighbourhoodStructure& n, double) { return 100 * n.interior_missing_share; }},
     {"shadow band [px]", "shadow_band_px",
      [](const NeighbourhoodStructure& n, double s) { return n.shadow_band_px * s; }},
     {"edge band [px]", "edge_band_px",
@@ -936,6 +939,8 @@ nlohmann::json SensorCheckReport::ToJson() const {
                       {"pixel_scale", row.pixel_scale},
                       {"pixels", n.pixels},
                       {"missing_share", n.missing_share},
+                      {"interior_pixels", n.interior_pixels},
+                      {"interior_missing_share", n.interior_missing_share},
                       {"shadow_band_px", n.shadow_band_px * row.pixel_scale},
                       {"edge_band_px", n.edge_band_px * row.pixel_scale},
                       {"shadow_band_across_px", n.shadow_band_across_px * row.pixel_scale},

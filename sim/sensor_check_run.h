@@ -59,6 +59,10 @@ struct RealView {
 // The neighbourhood of the object compared (AnalyseNeighbourhood): its mask grown by this many
 // pixels at the rendered sensor's focal length (in proportion at the real frame's).
 inline constexpr int kNeighbourhoodRadiusPx = 10;
+// The object's interior compared (MissingInside): its mask shrunk by this many pixels at the
+// rendered sensor's focal length (in proportion at the real frame's), clear of the bands at its
+// outline (a few pixels across, docs/sensor.md).
+inline constexpr int kInteriorErosionPx = 5;
 
 // Frame lags of the temporal correlation (AnalyseTemporalCorrelation against the first frame).
 inline constexpr int kTemporalLags[] = {1, 4};

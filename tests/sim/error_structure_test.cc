@@ -244,6 +244,49 @@ TEST(ErrorStructure, TemporalCorrelationIsTheFixedShareOfTheResidualVariance) {
                InputError);
 }
 
+// The interior: a 20 x 20 object whose outline ring is missing (the bands) and with three holes
+// on its surface, two of them inside the mask shrunk by 2 px (16 x 16 pixels), one on the ring's
+// inner side that the shrinking leaves out.
+TEST(ErrorStructure, MissingInsideCountsTheHolesOnTheSurfaceNotAtItsOutline) {
+  std::vector<float> depth(kWidth * kHeight, 2.0f);
+  std::vector<uint8_t> mask(depth.size(), 0);
+  for (int v = 40; v < 60; ++v) {
+    for (int u = 100; u < 120; ++u) {
+      mask[v * kWidth + u] = 1;
+      depth[v * kWidth + u] = (v == 40 || v == 59 || u == 100 || u == 119) ? 0.0f : 1.0f;
+    }
+  }
+  depth[50 * kWidth + 110] = 0.0f;
+  depth[45 * kWidth + 105] = std::nanf("");
+  depth[41 * kWidth + 110] = 0.0f;  // within 2 px of the outline
+  NeighbourhoodStructure n;
+  MissingInside(depth, kWidth, kHeight, mask, 2, {}, n);
+  EXPECT_DOUBLE_EQ(n.interior_pixels, 16.0 * 16.0);
+  EXPECT_DOUBLE_EQ(n.interior_missing_share, 2.0 / 256.0);
+  // Radius 0: the whole mask, the ring and all three holes.
+  MissingInside(depth, kWidth, kHeight, mask, 0, {}, n);
+  EXPECT_DOUBLE_EQ(n.interior_pixels, 400.0);
+  EXPECT_DOUBLE_EQ(n.interior_missing_share, (76.0 + 3.0) / 400.0);
+  // Left out pixels do not count; an object touching the image's side has no interior there.
+  std::vector<uint8_t> excluded(depth.size(), 0);
+  excluded[50 * kWidth + 110] = 1;
+  MissingInside(depth, kWidth, kHeight, mask, 2, excluded, n);
+  EXPECT_DOUBLE_EQ(n.interior_pixels, 255.0);
+  EXPECT_DOUBLE_EQ(n.interior_missing_share, 1.0 / 255.0);
+  std::vector<uint8_t> corner(depth.size(), 0);
+  for (int v = 0; v < 10; ++v) {
+    for (int u = 0; u < 10; ++u) corner[v * kWidth + u] = 1;
+  }
+  MissingInside(depth, kWidth, kHeight, corner, 2, {}, n);
+  EXPECT_DOUBLE_EQ(n.interior_pixels, 6.0 * 6.0);  // rows and columns 2-7
+  // No interior: NaN, and a mask of the wrong size is refused.
+  MissingInside(depth, kWidth, kHeight, mask, 10, {}, n);
+  EXPECT_DOUBLE_EQ(n.interior_pixels, 0.0);
+  EXPECT_TRUE(std::isnan(n.interior_missing_share));
+  EXPECT_THROW(MissingInside(depth, kWidth, kHeight, std::vector<uint8_t>(10), 2, {}, n),
+               InputError);
+}
+
 TEST(ErrorStructure, NeighbourhoodCountsTheObjectsGrownMaskAndTheRunsTouchingIt) {
   // A wall at 2 m; rows [50, 70) hold a near box (1 m) over columns [100, 120) with a 4-px shadow
   // run left of it and a 2-px edge run right of it (in rows 50-59 a 6-px one); a 5-px shadow run
