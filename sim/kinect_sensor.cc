@@ -81,8 +81,10 @@ struct KinectSensor::Impl {
     // The hit's SurfaceMaterial (structured-light mode only): ir_albedo (1 - specularity) and
     // specularity; 0 where nothing was hit.
     std::vector<float> ir_diffuse, ir_specular;
+    // SurfaceMaterial::subsurface_mm in metres (only where a material in the scene has one).
+    std::vector<float> ir_subsurface;
 
-    void Resize(int pixels, bool color_too, bool ir_too) {
+    void Resize(int pixels, bool color_too, bool ir_too, bool subsurface_too) {
       depth.assign(pixels, std::numeric_limits<float>::infinity());
       disparity.assign(pixels, 0.0f);
       cos_incidence.assign(pixels, 0.0f);
@@ -90,6 +92,7 @@ struct KinectSensor::Impl {
       occluded.assign(pixels, 0);
       ir_diffuse.assign(ir_too ? pixels : 0, 0.0f);
       ir_specular.assign(ir_too ? pixels : 0, 0.0f);
+      ir_subsurface.assign(ir_too && subsurface_too ? pixels : 0, 0.0f);
     }
   };
 
@@ -130,7 +133,9 @@ struct KinectSensor::Impl {
           cos_incidence_(view.current.cos_incidence.data()),
           color_(view.needs_color ? view.current.color.data() : nullptr),
           ir_diffuse_(view.needs_ir ? view.current.ir_diffuse.data() : nullptr),
-          ir_specular_(view.needs_ir ? view.current.ir_specular.data() : nullptr) {}
+          ir_specular_(view.needs_ir ? view.current.ir_specular.data() : nullptr),
+          ir_subsurface_(view.current.ir_subsurface.empty() ? nullptr
+                                                            : view.current.ir_subsurface.data()) {}
 
     void Consume(const HitPacket& packet) override {
       float* __restrict depth = depth_;
@@ -172,6 +177,7 @@ struct KinectSensor::Impl {
             cos_incidence[p] = 0.0f;
             if (color != nullptr) std::fill_n(color + 3 * p, 3, s_.background);
             if (ir_diffuse_ != nullptr) ir_diffuse_[p] = ir_specular_[p] = 0.0f;
+            if (ir_subsurface_ != nullptr) ir_subsurface_[p] = 0.0f;
             continue;
           }
           depth[p] = packet.depth[i];
@@ -189,6 +195,7 @@ struct KinectSensor::Impl {
       const std::vector<float>& faces = s_.face_ir_diffuse[object];
       ir_diffuse_[p] = faces.empty() ? s_.object_ir_diffuse[object] : faces[packet.face[i]];
       ir_specular_[p] = s_.object_ir_specular[object];
+      if (ir_subsurface_ != nullptr) ir_subsurface_[p] = s_.object_subsurface_m[object];
     }
 
     const Impl& s_;
@@ -200,6 +207,7 @@ struct KinectSensor::Impl {
     uint8_t* color_;
     float* ir_diffuse_;
     float* ir_specular_;
+    float* ir_subsurface_;
   };
 
   // Lambertian shading in linear light of a unit normal facing the camera, then sRGB.
@@ -259,6 +267,8 @@ struct KinectSensor::Impl {
   SensorTimings timings;
   std::vector<const uint8_t*> face_colors;  // per object
   std::vector<float> object_ir_diffuse, object_ir_specular;  // per object (SurfaceMaterial)
+  std::vector<float> object_subsurface_m;                    // per object, metres
+  bool any_subsurface = false;                               // some object's is above 0
   // Per object, per face: the diffuse IR reflectance of a printed surface (colour_contrast > 0);
   // empty: object_ir_diffuse for every face.
   std::vector<std::vector<float>> face_ir_diffuse;
@@ -604,6 +614,9 @@ struct KinectSensor::Impl {
       if (view.needs_ir) {
         std::copy_n(&from.ir_diffuse[a], n, &to.ir_diffuse[a]);
         std::copy_n(&from.ir_specular[a], n, &to.ir_specular[a]);
+        if (!from.ir_subsurface.empty()) {
+          std::copy_n(&from.ir_subsurface[a], n, &to.ir_subsurface[a]);
+        }
       }
     }
   }
@@ -618,7 +631,7 @@ struct KinectSensor::Impl {
     std::vector<int> all_rows(k.height);
     std::iota(all_rows.begin(), all_rows.end(), 0);
     if (view.current.depth.size() != static_cast<size_t>(pixels)) {
-      view.current.Resize(pixels, view.needs_color, view.needs_ir);
+      view.current.Resize(pixels, view.needs_color, view.needs_ir, any_subsurface);
     }
     auto t0 = Clock::now();
     bool all_rows_dirty = view.all_dirty;
@@ -693,6 +706,10 @@ struct KinectSensor::Impl {
     const Geometry& g = dv.current;
     internal::SpeckleScene scene{g.depth.data(),    g.disparity.data(),  g.cos_incidence.data(),
                                  g.occluded.data(), g.ir_diffuse.data(), g.ir_specular.data()};
+    if (!g.ir_subsurface.empty()) {
+      scene.subsurface_m = g.ir_subsurface.data();
+      scene.focal_px = static_cast<float>(dv.intrinsics.fx);
+    }
     ir_image.resize(g.depth.size());
     speckle->RenderIr(scene, static_cast<uint32_t>(Mix64(frame_key ^ 0x5851F42D4C957F2DULL)),
                       ir_image.data());
@@ -853,6 +870,8 @@ KinectSensor::KinectSensor(const KinectSensorOptions& options, const RayScene* s
     s.object_ir_diffuse.push_back(
         static_cast<float>(material.ir_albedo * (1.0 - material.specularity)));
     s.object_ir_specular.push_back(static_cast<float>(material.specularity));
+    s.object_subsurface_m.push_back(static_cast<float>(material.subsurface_mm / 1000.0));
+    s.any_subsurface = s.any_subsurface || material.subsurface_mm > 0;
     s.face_ir_diffuse.emplace_back();
     if (material.colour_contrast > 0) {
       const TriangleMesh& mesh = scene->object_mesh(o);

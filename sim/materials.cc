@@ -8,6 +8,10 @@ void SurfaceMaterial::Validate(const std::string& prefix) const {
   RequireProbability(ir_albedo, prefix + ".ir_albedo");
   RequireProbability(specularity, prefix + ".specularity");
   RequireProbability(colour_contrast, prefix + ".colour_contrast");
+  if (!(subsurface_mm >= 0 && subsurface_mm <= 20)) {
+    ThrowBadValue(prefix + ".subsurface_mm", FormatNumber(subsurface_mm),
+                  "a spread under the surface in [0, 20] mm");
+  }
 }
 
 void SceneMaterials::Validate(const std::string& prefix) const {

@@ -18,12 +18,19 @@ struct SurfaceMaterial {
   // while the dyes of coloured inks are largely transparent there, so a bright colour of any hue
   // stays bright: the brightest channel, not the luminance. 0: one albedo for the whole object.
   double colour_contrast = 0.0;
+  // Translucent surfaces (foam, skin, wax): the diffuse return leaves the surface after
+  // scattering beneath it, spread around the point the light entered by a Gaussian of this
+  // standard deviation [mm] on the surface, so each projected dot comes back blurred
+  // (docs/sensor.md, "Translucent surfaces"). 0: an opaque surface, each dot returned where it
+  // lands.
+  double subsurface_mm = 0.0;
 
   template <class V>
   void VisitFields(V& v) {
     v("ir_albedo", ir_albedo);
     v("specularity", specularity);
     v("colour_contrast", colour_contrast);
+    v("subsurface_mm", subsurface_mm);
   }
   void Validate(const std::string& prefix) const;
 };

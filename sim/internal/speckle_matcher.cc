@@ -52,17 +52,11 @@ MMH_SIMD_CLONES void GlareRow(const float* __restrict c, const uint8_t* __restri
   for (int k = 0; k < n; ++k) out[k] *= static_cast<float>(occluded[k] == 0);
 }
 
-// One row of the IR image in ADC counts (docs/sensor.md, "Structured light", step 2): the
-// pattern at column u - d (linear between 1/8 px samples of `pattern`), Lambertian return,
-// glare (cos^n precomputed), 1 / z^2 fall-off, ambient light, sensor noise (normal: standard
-// normals), clip, quantisation.
-MMH_SIMD_CLONES void IrRow(const IrParams& p, const float* __restrict pattern,
-                           const float* __restrict depth, const float* __restrict disparity,
-                           const float* __restrict cos_incidence,
-                           const uint8_t* __restrict occluded, const float* __restrict diffuse,
-                           const float* __restrict specular, const float* __restrict glare,
-                           const float* __restrict normal, int n, float* __restrict dots,
-                           uint16_t* __restrict ir) {
+// The dots one row of the IR image sees (docs/sensor.md, "Structured light", step 2): the
+// pattern at column u - d (linear between 1/8 px samples of `pattern`), 0 in the IR shadow.
+MMH_SIMD_CLONES void DotsRow(const IrParams& p, const float* __restrict pattern,
+                             const float* __restrict disparity, const uint8_t* __restrict occluded,
+                             int n, float* __restrict dots) {
   const float x_min = p.x_min, last_position = p.last_position;
   for (int u = 0; u < n; ++u) {
     float position = (static_cast<float>(u) - disparity[u] - x_min) * 8.0f;
@@ -75,6 +69,16 @@ MMH_SIMD_CLONES void IrRow(const IrParams& p, const float* __restrict pattern,
     dots[u] =
         (pattern[k] + t * (pattern[k + 1] - pattern[k])) * static_cast<float>(occluded[u] == 0);
   }
+}
+
+// One row of the IR image in ADC counts from its dots (DotsRow): Lambertian return, glare
+// (cos^n precomputed), 1 / z^2 fall-off, ambient light, sensor noise (normal: standard normals),
+// clip, quantisation.
+MMH_SIMD_CLONES void IrRow(const IrParams& p, const float* __restrict depth,
+                           const float* __restrict disparity, const float* __restrict cos_incidence,
+                           const float* __restrict diffuse, const float* __restrict specular,
+                           const float* __restrict glare, const float* __restrict normal,
+                           const float* __restrict dots, int n, uint16_t* __restrict ir) {
   const float power = p.power, ambient = p.ambient, read2 = p.read2, shot = p.shot,
               levels = p.levels, gain = p.gain;
   for (int u = 0; u < n; ++u) {
@@ -507,6 +511,32 @@ int SpeckleMatcher::Reference(int x, int v) const {
   return reference_[static_cast<size_t>(v) * columns_ + (x - x_min_)];
 }
 
+float SpeckleMatcher::ScatteredPattern(float x, int v, float sigma_px,
+                                       std::vector<float>& weights) const {
+  // A Gaussian of sigma_px over rows (whole rows: the pattern is sampled per row) and over
+  // columns every quarter pixel, to three sigma, normalised.
+  constexpr float kStep = 0.25f;
+  const int rows = static_cast<int>(std::ceil(3.0f * sigma_px));
+  const int columns = static_cast<int>(std::ceil(3.0f * sigma_px / kStep));
+  const float inverse = 1.0f / (2.0f * sigma_px * sigma_px);
+  weights.resize(2 * static_cast<size_t>(columns) + 1);
+  for (int i = -columns; i <= columns; ++i) {
+    const float dx = i * kStep;
+    weights[i + columns] = std::exp(-dx * dx * inverse);
+  }
+  double sum = 0, total = 0;
+  for (int j = -rows; j <= rows; ++j) {
+    const float row_weight = std::exp(-static_cast<float>(j * j) * inverse);
+    const int r = std::clamp(v + j, 0, height_ - 1);
+    for (int i = -columns; i <= columns; ++i) {
+      const float weight = row_weight * weights[i + columns];
+      sum += static_cast<double>(weight) * Pattern(x + i * kStep, r);
+      total += weight;
+    }
+  }
+  return static_cast<float>(sum / total);
+}
+
 float SpeckleMatcher::Pattern(float x, int v) const {
   float position = (x - static_cast<float>(x_min_)) * kSubsamples;
   position = std::clamp(position, 0.0f, static_cast<float>(samples_ - 2));
@@ -539,17 +569,33 @@ void SpeckleMatcher::RenderIr(const SpeckleScene& scene, uint32_t key, uint16_t*
   noise.key_c = key;
   tbb::parallel_for(tbb::blocked_range<int>(0, height_, 16), [&](const tbb::blocked_range<int>& r) {
     const int w = width_;
-    std::vector<float> normal(w), glare(w), scratch(w), dots(w);
+    std::vector<float> normal(w), glare(w), scratch(w), dots(w), blur_weights;
     std::vector<uint32_t> unused(w);
     for (int v = r.begin(); v != r.end(); ++v) {
       const size_t row = static_cast<size_t>(v) * w;
       DepthNoise(noise, static_cast<uint32_t>(row), w, unused.data(), normal.data());
       GlareRow(scene.cos_incidence + row, scene.occluded + row, exponent, w, scratch.data(),
                glare.data());
-      IrRow(p, &pattern_[static_cast<size_t>(v) * samples_], scene.depth + row,
-            scene.disparity + row, scene.cos_incidence + row, scene.occluded + row,
-            scene.ir_diffuse + row, scene.ir_specular + row, glare.data(), normal.data(), w,
-            dots.data(), ir + row);
+      DotsRow(p, &pattern_[static_cast<size_t>(v) * samples_], scene.disparity + row,
+              scene.occluded + row, w, dots.data());
+      if (scene.subsurface_m != nullptr) {
+        // Translucent surfaces: the dots around the entry point, blurred by the spread under
+        // the surface (subsurface_m f / z pixels at depth z; below 0.05 px it is no blur).
+        for (int u = 0; u < w; ++u) {
+          const size_t q = row + u;
+          if (!(scene.subsurface_m[q] > 0) || scene.disparity[q] == 0.0f ||
+              scene.occluded[q] != 0) {
+            continue;
+          }
+          const float sigma = scene.subsurface_m[q] * scene.focal_px / scene.depth[q];
+          if (sigma < 0.05f) continue;
+          dots[u] =
+              ScatteredPattern(static_cast<float>(u) - scene.disparity[q], v, sigma, blur_weights);
+        }
+      }
+      IrRow(p, scene.depth + row, scene.disparity + row, scene.cos_incidence + row,
+            scene.ir_diffuse + row, scene.ir_specular + row, glare.data(), normal.data(),
+            dots.data(), w, ir + row);
     }
   });
 }

@@ -24,6 +24,10 @@ struct SpeckleScene {
   const uint8_t* occluded = nullptr;
   const float* ir_diffuse = nullptr;     // SurfaceMaterial: ir_albedo (1 - specularity)
   const float* ir_specular = nullptr;    // SurfaceMaterial: specularity
+  // SurfaceMaterial::subsurface_mm in metres (nullptr: every surface opaque) and the depth view's
+  // focal length [px], which turns it into the dots' blur in pixels at each depth.
+  const float* subsurface_m = nullptr;
+  float focal_px = 0;
 };
 
 // How a matched disparity becomes a depth pixel (the Kinect's raw lattice, range, TUM units).
@@ -57,6 +61,11 @@ class SpeckleMatcher {
   int Reference(int x, int v) const;
   // The pattern at sub-pixel column x of row v, as projected (linear between 1/8 px samples).
   float Pattern(float x, int v) const;
+  // The pattern as a translucent surface returns it at sub-pixel column x of row v: the
+  // projected pattern around x blurred by a Gaussian of sigma_px (rows beyond the image's
+  // repeat its first or last).
+  // `weights`: scratch.
+  float ScatteredPattern(float x, int v, float sigma_px, std::vector<float>& weights) const;
   int x_min() const { return x_min_; }
   // The integer disparity at which pixel p's search is centred (-1: nothing hit), from the
   // rendered disparity (as Match computes it).

@@ -200,6 +200,42 @@ void ExpectTheBruteForceCorrelationOfEveryWindow(const StructuredLightOptions& o
   EXPECT_LE(differ, static_cast<int>(n / 2000)) << differ << " of " << n << " pixels differ";
 }
 
+// Translucent surfaces (SurfaceMaterial::subsurface_mm): the pattern blurred by a Gaussian. A
+// vanishing blur returns the pattern itself; a wider one keeps the pattern's mean and lowers its
+// spread, the more the wider; the blur spreads a dot's light over as many pixels as its sigma says
+// (the second moment of the blurred pattern around an isolated bright sample, along x, grows by
+// sigma^2).
+TEST(SpeckleMatcher, ScatteredPatternIsThePatternBlurred) {
+  StructuredLightOptions options;
+  const SpeckleMatcher matcher(options, kWidth, kHeight, kFocalBaseline / 0.4);
+  std::vector<float> scratch;
+  for (const float x : {10.0f, 33.3f, 101.875f}) {
+    EXPECT_NEAR(matcher.ScatteredPattern(x, 30, 0.05f, scratch), matcher.Pattern(x, 30), 1e-6);
+  }
+  auto moments = [&](float sigma) {
+    double sum = 0, square = 0;
+    int n = 0;
+    for (int v = 20; v < 50; ++v) {
+      for (float x = 20; x < 180; x += 0.5f) {
+        const double value =
+            sigma > 0 ? matcher.ScatteredPattern(x, v, sigma, scratch) : matcher.Pattern(x, v);
+        sum += value;
+        square += value * value;
+        ++n;
+      }
+    }
+    const double mean = sum / n;
+    return std::make_pair(mean, std::sqrt(square / n - mean * mean));
+  };
+  const auto [sharp_mean, sharp_sd] = moments(0);
+  const auto [one_mean, one_sd] = moments(1.0f);
+  const auto [three_mean, three_sd] = moments(3.0f);
+  EXPECT_NEAR(one_mean, sharp_mean, 0.03 * sharp_mean);
+  EXPECT_NEAR(three_mean, sharp_mean, 0.03 * sharp_mean);
+  EXPECT_LT(one_sd, 0.8 * sharp_sd);
+  EXPECT_LT(three_sd, 0.5 * one_sd);
+}
+
 TEST(SpeckleMatcher, MatchesTheBruteForceCorrelationOfEveryWindow) {
   ExpectTheBruteForceCorrelationOfEveryWindow(StructuredLightOptions());
 }

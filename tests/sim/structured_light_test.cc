@@ -161,6 +161,41 @@ TEST(StructuredLight, PrintedFacesFollowTheirColour) {
   }
 }
 
+// A translucent wall (SurfaceMaterial::subsurface_mm) returns each dot blurred: its windows
+// correlate less sharply with the reference and more of them fail; an opaque wall's frame is
+// the same with or without the blur's machinery (the scene has a translucent object elsewhere).
+TEST(StructuredLight, TranslucentSurfacesBlurTheDotsAndLoseMatches) {
+  auto render = [&](double subsurface_mm) {
+    SurfaceMaterial material{0.6, 0.0};
+    material.subsurface_mm = subsurface_mm;
+    return CentreStats(RenderWall(0.6, material, StructuredLight()), 0.6).missing / (400.0 * 300.0);
+  };
+  const double opaque = render(0), slight = render(0.3), foam = render(1.5);
+  EXPECT_LT(opaque, 0.01);
+  EXPECT_LT(slight, 0.02);
+  EXPECT_GT(foam, opaque + 0.05) << opaque << " " << slight << " " << foam;
+  // An opaque wall beside a translucent box far off to the side: the same bytes as alone.
+  RayScene scene;
+  scene.SetMaterial(scene.AddStatic("wall", Quad(20, 20), WallAt(1.5)), SurfaceMaterial{0.6, 0.0});
+  SurfaceMaterial translucent{0.6, 0.0};
+  translucent.subsurface_mm = 2.0;
+  scene.SetMaterial(scene.AddStatic("box", Quad(0.1, 0.1),
+                                    Rigid3(WallAt(1.0).rotation, Eigen::Vector3d(50, 0, 1.0))),
+                    translucent);
+  scene.Commit();
+  KinectSensor sensor(StructuredLight(), &scene, Rigid3::Identity());
+  EXPECT_EQ(sensor.Render(0, RenderMode::kFull).depth,
+            RenderWall(1.5, SurfaceMaterial{0.6, 0.0}, StructuredLight()).depth);
+  try {
+    SurfaceMaterial bad;
+    bad.subsurface_mm = -1;
+    bad.Validate("scene.materials.skin");
+    FAIL() << "accepted a negative spread";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("scene.materials.skin.subsurface_mm"));
+  }
+}
+
 TEST(StructuredLight, ErrorsAreSpatiallyCorrelatedUnlikeTheStatisticalModel) {
   // Residual correlation of horizontal neighbours on a wall at 2 m: block matching shares most
   // of the window between neighbours (correlated), per-pixel noise does not.
