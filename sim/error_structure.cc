@@ -395,7 +395,8 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   const int lags = n / 2;
   const std::vector<Patch> patches =
       PlanarPatches(depth_m, width, height, intrinsics, options, &calibration, &noise);
-  std::vector<double> numerator(lags + 1, 0.0), ratios;
+  std::vector<double> numerator(lags + 1, 0.0), along_rows(lags + 1, 0.0),
+      along_columns(lags + 1, 0.0), ratios;
   std::array<std::vector<double>, ErrorStructure::kIncidenceBins> ratios_by_incidence;
   double energy = 0;
   for (const Patch* inlier : InlierPatches(patches, options)) {
@@ -410,8 +411,16 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
         const double r = p.residual[j * n + i];
         energy += 2 * r * r;
         for (int k = 1; k <= lags; ++k) {
-          if (i + k < n) numerator[k] += r * p.residual[j * n + i + k];
-          if (j + k < n) numerator[k] += r * p.residual[(j + k) * n + i];
+          if (i + k < n) {
+            const double product = r * p.residual[j * n + i + k];
+            numerator[k] += product;
+            along_rows[k] += product;
+          }
+          if (j + k < n) {
+            const double product = r * p.residual[(j + k) * n + i];
+            numerator[k] += product;
+            along_columns[k] += product;
+          }
         }
       }
     }
@@ -421,10 +430,14 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
     s.noise_over_model_by_incidence[b] = Median(ratios_by_incidence[b]);
   }
   s.autocorrelation.assign(lags, kNaN);
+  s.autocorrelation_along_rows.assign(lags, kNaN);
+  s.autocorrelation_along_columns.assign(lags, kNaN);
   if (energy > 0) {
     for (int k = 1; k <= lags; ++k) {
       // Pairs at lag k are fewer than squares: normalise per pair count (n - k of n per line).
       s.autocorrelation[k - 1] = numerator[k] / energy * n / (n - k);
+      s.autocorrelation_along_rows[k - 1] = along_rows[k] / (energy / 2) * n / (n - k);
+      s.autocorrelation_along_columns[k - 1] = along_columns[k] / (energy / 2) * n / (n - k);
     }
   }
   const double target = std::exp(-1.0);
@@ -494,6 +507,8 @@ nlohmann::json ToJson(const ErrorStructure& s) {
           {"noise_over_model", s.noise_over_model},
           {"noise_over_model_by_incidence_0_20_40_60_deg", s.noise_over_model_by_incidence},
           {"autocorrelation", s.autocorrelation},
+          {"autocorrelation_along_rows", s.autocorrelation_along_rows},
+          {"autocorrelation_along_columns", s.autocorrelation_along_columns},
           {"correlation_length_px", s.correlation_length_px}};
 }
 
@@ -530,6 +545,14 @@ std::string FormatRealismTable(const std::vector<std::string>& names,
       {"residual autocorrelation lag 1",
        [](const ErrorStructure& s) {
          return s.autocorrelation.empty() ? kNaN : s.autocorrelation[0];
+       }},
+      {"  ... along the rows",
+       [](const ErrorStructure& s) {
+         return s.autocorrelation_along_rows.empty() ? kNaN : s.autocorrelation_along_rows[0];
+       }},
+      {"  ... along the columns",
+       [](const ErrorStructure& s) {
+         return s.autocorrelation_along_columns.empty() ? kNaN : s.autocorrelation_along_columns[0];
        }},
       {"residual autocorrelation lag 2",
        [](const ErrorStructure& s) {

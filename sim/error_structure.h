@@ -70,6 +70,9 @@ struct ErrorStructure {
   static constexpr double kIncidenceBinDeg = 20.0;
   std::array<double, kIncidenceBins> noise_over_model_by_incidence{};
   std::vector<double> autocorrelation;  // rho(1) .. rho(patch_size / 2)
+  // The same along the rows (horizontal lags, the direction the matcher searches) and along the
+  // columns alone: a block matcher's window shape shows in their ratio.
+  std::vector<double> autocorrelation_along_rows, autocorrelation_along_columns;
   double correlation_length_px = 0;
 };
 

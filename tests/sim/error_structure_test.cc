@@ -192,6 +192,57 @@ TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[2]));
 }
 
+// Noise averaged along the rows only (3 pixels side by side): correlated along the rows, not
+// along the columns; the pooled value is their mean. Oracle as above, with the 1 x 3 box's
+// covariance (overlap / 3 within a row, 0 across rows), each direction's pairs over the trace.
+TEST(ErrorStructure, ResidualAutocorrelationAlongRowsAndAlongColumns) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 0.003);
+  std::vector<double> white((kWidth + 2) * kHeight);
+  for (double& x : white) x = normal(rng);
+  std::vector<float> depth(kWidth * kHeight);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      double e = 0;
+      for (int i = 0; i < 3; ++i) e += white[v * (kWidth + 2) + u + i];
+      depth[v * kWidth + u] =
+          static_cast<float>(1.5 + 0.0004 * u - 0.0003 * v + e / std::sqrt(3.0));
+    }
+  }
+  const ErrorStructure s = AnalyseErrorStructure(depth, kWidth, kHeight, PinholeIntrinsics(),
+                                                 KinectCalibration(), AxialNoiseModel());
+  ASSERT_EQ(s.autocorrelation_along_rows.size(), 4u);
+  ASSERT_EQ(s.autocorrelation_along_columns.size(), 4u);
+  constexpr int n = 9;
+  Eigen::MatrixXd design(n * n, 3), cov(n * n, n * n);
+  for (int a = 0; a < n * n; ++a) {
+    design.row(a) << a % n, a / n, 1.0;
+    for (int b = 0; b < n * n; ++b) {
+      const int du = std::abs(a % n - b % n), dv = std::abs(a / n - b / n);
+      cov(a, b) = dv == 0 ? std::max(0, 3 - du) / 3.0 : 0.0;
+    }
+  }
+  const Eigen::MatrixXd residual_maker =
+      Eigen::MatrixXd::Identity(n * n, n * n) -
+      design * (design.transpose() * design).inverse() * design.transpose();
+  const Eigen::MatrixXd r = residual_maker * cov * residual_maker;
+  for (int k = 1; k <= 2; ++k) {
+    double rows = 0, columns = 0;
+    for (int a = 0; a < n * n; ++a) {
+      if (a % n + k < n) rows += r(a, a + k);
+      if (a / n + k < n) columns += r(a, a + k * n);
+    }
+    EXPECT_NEAR(s.autocorrelation_along_rows[k - 1], rows / r.trace() * n / (n - k), 0.03) << k;
+    EXPECT_NEAR(s.autocorrelation_along_columns[k - 1], columns / r.trace() * n / (n - k), 0.03)
+        << k;
+    EXPECT_NEAR(s.autocorrelation[k - 1],
+                (s.autocorrelation_along_rows[k - 1] + s.autocorrelation_along_columns[k - 1]) / 2,
+                1e-9);
+  }
+  EXPECT_GT(s.autocorrelation_along_rows[0], 0.5);
+  EXPECT_LT(std::abs(s.autocorrelation_along_columns[0]), 0.1);
+}
+
 TEST(ErrorStructure, CauseTableCountsEachClassAgainstEachCause) {
   // One row, 10 pixels: a border run of 2 (the sensor says border), a shadow run of 3 beside a
   // step down from 2 m to 1 m (the sensor: 2 shadow, 1 no match), valid pixels between.
