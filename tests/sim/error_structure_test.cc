@@ -143,6 +143,22 @@ std::vector<float> NoisyPlane(bool smoothed, double sigma) {
   return depth;
 }
 
+// The expected residual covariance of an n x n window after the plane fit, (I - H) S (I - H),
+// with H the fit's hat matrix and S(a, b) = covariance(|du|, |dv|) of the noise.
+Eigen::MatrixXd FittedResidualCovariance(int n, double (*covariance)(int du, int dv)) {
+  Eigen::MatrixXd design(n * n, 3), cov(n * n, n * n);
+  for (int a = 0; a < n * n; ++a) {
+    design.row(a) << a % n, a / n, 1.0;
+    for (int b = 0; b < n * n; ++b) {
+      cov(a, b) = covariance(std::abs(a % n - b % n), std::abs(a / n - b / n));
+    }
+  }
+  const Eigen::MatrixXd residual_maker =
+      Eigen::MatrixXd::Identity(n * n, n * n) -
+      design * (design.transpose() * design).inverse() * design.transpose();
+  return residual_maker * cov * residual_maker;
+}
+
 TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   const ErrorStructure white =
       AnalyseErrorStructure(NoisyPlane(false, 0.003), kWidth, kHeight, PinholeIntrinsics(),
@@ -159,18 +175,8 @@ TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   // (I - H) S (I - H) with H the plane fit's hat matrix and S the 3 x 3 box's covariance
   // (overlap of the two pixels' boxes / 9), pooled as the estimator pools it.
   constexpr int n = 9;
-  Eigen::MatrixXd design(n * n, 3), cov(n * n, n * n);
-  for (int a = 0; a < n * n; ++a) {
-    design.row(a) << a % n, a / n, 1.0;
-    for (int b = 0; b < n * n; ++b) {
-      const int du = std::abs(a % n - b % n), dv = std::abs(a / n - b / n);
-      cov(a, b) = std::max(0, 3 - du) * std::max(0, 3 - dv) / 9.0;
-    }
-  }
-  const Eigen::MatrixXd residual_maker =
-      Eigen::MatrixXd::Identity(n * n, n * n) -
-      design * (design.transpose() * design).inverse() * design.transpose();
-  const Eigen::MatrixXd r = residual_maker * cov * residual_maker;
+  const Eigen::MatrixXd r = FittedResidualCovariance(
+      n, [](int du, int dv) { return std::max(0, 3 - du) * std::max(0, 3 - dv) / 9.0; });
   for (int k = 1; k <= 3; ++k) {
     double pairs = 0;
     for (int a = 0; a < n * n; ++a) {
@@ -214,18 +220,8 @@ TEST(ErrorStructure, ResidualAutocorrelationAlongRowsAndAlongColumns) {
   ASSERT_EQ(s.autocorrelation_along_rows.size(), 4u);
   ASSERT_EQ(s.autocorrelation_along_columns.size(), 4u);
   constexpr int n = 9;
-  Eigen::MatrixXd design(n * n, 3), cov(n * n, n * n);
-  for (int a = 0; a < n * n; ++a) {
-    design.row(a) << a % n, a / n, 1.0;
-    for (int b = 0; b < n * n; ++b) {
-      const int du = std::abs(a % n - b % n), dv = std::abs(a / n - b / n);
-      cov(a, b) = dv == 0 ? std::max(0, 3 - du) / 3.0 : 0.0;
-    }
-  }
-  const Eigen::MatrixXd residual_maker =
-      Eigen::MatrixXd::Identity(n * n, n * n) -
-      design * (design.transpose() * design).inverse() * design.transpose();
-  const Eigen::MatrixXd r = residual_maker * cov * residual_maker;
+  const Eigen::MatrixXd r = FittedResidualCovariance(
+      n, [](int du, int dv) { return dv == 0 ? std::max(0, 3 - du) / 3.0 : 0.0; });
   for (int k = 1; k <= 2; ++k) {
     double rows = 0, columns = 0;
     for (int a = 0; a < n * n; ++a) {
