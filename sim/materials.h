@@ -22,7 +22,7 @@ struct SurfaceMaterial {
   // scattering beneath it, spread around the point the light entered by a Gaussian of this
   // standard deviation [mm] on the surface, so each projected dot comes back blurred
   // (docs/sensor.md, "Translucent surfaces"). 0: an opaque surface, each dot returned where it
-  // lands.
+  // lands. At most 3 mm (its cost per pixel grows with the square of the spread).
   double subsurface_mm = 0.0;
 
   template <class V>

@@ -188,7 +188,7 @@ TEST(StructuredLight, TranslucentSurfacesBlurTheDotsAndLoseMatches) {
             RenderWall(1.5, SurfaceMaterial{0.6, 0.0}, StructuredLight()).depth);
   try {
     SurfaceMaterial bad;
-    bad.subsurface_mm = -1;
+    bad.subsurface_mm = 3.5;
     bad.Validate("scene.materials.skin");
     FAIL() << "accepted a negative spread";
   } catch (const InputError& e) {
