@@ -228,9 +228,12 @@ std::vector<uint8_t> GrowMask(std::span<const uint8_t> mask, int width, int heig
   return region;
 }
 
-void MissingInside(const std::vector<float>& depth_m, int width, int height,
-                   std::span<const uint8_t> mask, int radius_px, std::span<const uint8_t> excluded,
-                   NeighbourhoodStructure& n) {
+namespace {
+
+// The depths, the mask and `excluded` (empty: none) of one width x height image; returns the
+// pixel count.
+size_t CheckMaskSizes(const std::vector<float>& depth_m, int width, int height,
+                      std::span<const uint8_t> mask, std::span<const uint8_t> excluded) {
   const size_t pixels = static_cast<size_t>(width) * height;
   if (depth_m.size() != pixels || mask.size() != pixels ||
       (!excluded.empty() && excluded.size() != pixels)) {
@@ -239,6 +242,15 @@ void MissingInside(const std::vector<float>& depth_m, int width, int height,
                       " excluded and " + std::to_string(depth_m.size()) + " depths",
                   std::to_string(pixels) + " of each (none excluded: 0)");
   }
+  return pixels;
+}
+
+}  // namespace
+
+void MissingInside(const std::vector<float>& depth_m, int width, int height,
+                   std::span<const uint8_t> mask, int radius_px, std::span<const uint8_t> excluded,
+                   NeighbourhoodStructure& n) {
+  CheckMaskSizes(depth_m, width, height, mask, excluded);
   // Shrinking the mask is growing its complement; beyond the image counts as outside, so a pixel
   // within radius_px of the image's side is not interior.
   const int pad = radius_px;
@@ -270,14 +282,7 @@ NeighbourhoodStructure AnalyseNeighbourhood(const std::vector<float>& depth_m, i
                                             int height, std::span<const uint8_t> mask,
                                             int radius_px, const ErrorStructureOptions& options,
                                             std::span<const uint8_t> excluded) {
-  const size_t pixels = static_cast<size_t>(width) * height;
-  if (depth_m.size() != pixels || mask.size() != pixels ||
-      (!excluded.empty() && excluded.size() != pixels)) {
-    ThrowBadValue("mask", std::to_string(mask.size()) + " pixels, " +
-                              std::to_string(excluded.size()) + " excluded and " +
-                              std::to_string(depth_m.size()) + " depths",
-                  std::to_string(pixels) + " of each (none excluded: 0)");
-  }
+  const size_t pixels = CheckMaskSizes(depth_m, width, height, mask, excluded);
   std::vector<uint8_t> region = GrowMask(mask, width, height, radius_px);
   auto is_excluded = [&](size_t p) { return !excluded.empty() && excluded[p] != 0; };
   for (size_t p = 0; p < pixels; ++p) {
@@ -395,6 +400,8 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   const int lags = n / 2;
   const std::vector<Patch> patches =
       PlanarPatches(depth_m, width, height, intrinsics, options, &calibration, &noise);
+  // numerator pools both directions in the order it always has (its value bit for bit); the
+  // split sums are the same products by direction.
   std::vector<double> numerator(lags + 1, 0.0), along_rows(lags + 1, 0.0),
       along_columns(lags + 1, 0.0), ratios;
   std::array<std::vector<double>, ErrorStructure::kIncidenceBins> ratios_by_incidence;

@@ -60,8 +60,8 @@ struct RealView {
 // pixels at the rendered sensor's focal length (in proportion at the real frame's).
 inline constexpr int kNeighbourhoodRadiusPx = 10;
 // The object's interior compared (MissingInside): its mask shrunk by this many pixels at the
-// rendered sensor's focal length (in proportion at the real frame's), clear of the bands at its
-// outline (a few pixels across, docs/sensor.md).
+// rendered sensor's focal length (in proportion at the real frame's), clear of what the outline
+// does (it erodes by under a pixel, docs/sensor.md, "Inside the objects").
 inline constexpr int kInteriorErosionPx = 5;
 
 // Frame lags of the temporal correlation (AnalyseTemporalCorrelation against the first frame).

@@ -537,6 +537,22 @@ float SpeckleMatcher::ScatteredPattern(float x, int v, float sigma_px,
   return static_cast<float>(sum / total);
 }
 
+void SpeckleMatcher::ScatterDots(const SpeckleScene& scene, int v, float* dots,
+                                 std::vector<float>& weights) const {
+  // The dots around each translucent pixel's entry point, blurred by the spread under its surface
+  // (subsurface_m f / z pixels at depth z; below 0.05 px it is no blur).
+  const size_t row = static_cast<size_t>(v) * width_;
+  for (int u = 0; u < width_; ++u) {
+    const size_t q = row + u;
+    if (!(scene.subsurface_m[q] > 0) || scene.disparity[q] == 0.0f || scene.occluded[q] != 0) {
+      continue;
+    }
+    const float sigma = scene.subsurface_m[q] * scene.focal_px / scene.depth[q];
+    if (sigma < 0.05f) continue;
+    dots[u] = ScatteredPattern(static_cast<float>(u) - scene.disparity[q], v, sigma, weights);
+  }
+}
+
 float SpeckleMatcher::Pattern(float x, int v) const {
   float position = (x - static_cast<float>(x_min_)) * kSubsamples;
   position = std::clamp(position, 0.0f, static_cast<float>(samples_ - 2));
@@ -578,21 +594,7 @@ void SpeckleMatcher::RenderIr(const SpeckleScene& scene, uint32_t key, uint16_t*
                glare.data());
       DotsRow(p, &pattern_[static_cast<size_t>(v) * samples_], scene.disparity + row,
               scene.occluded + row, w, dots.data());
-      if (scene.subsurface_m != nullptr) {
-        // Translucent surfaces: the dots around the entry point, blurred by the spread under
-        // the surface (subsurface_m f / z pixels at depth z; below 0.05 px it is no blur).
-        for (int u = 0; u < w; ++u) {
-          const size_t q = row + u;
-          if (!(scene.subsurface_m[q] > 0) || scene.disparity[q] == 0.0f ||
-              scene.occluded[q] != 0) {
-            continue;
-          }
-          const float sigma = scene.subsurface_m[q] * scene.focal_px / scene.depth[q];
-          if (sigma < 0.05f) continue;
-          dots[u] =
-              ScatteredPattern(static_cast<float>(u) - scene.disparity[q], v, sigma, blur_weights);
-        }
-      }
+      if (scene.subsurface_m != nullptr) ScatterDots(scene, v, dots.data(), blur_weights);
       IrRow(p, scene.depth + row, scene.disparity + row, scene.cos_incidence + row,
             scene.ir_diffuse + row, scene.ir_specular + row, glare.data(), normal.data(),
             dots.data(), w, ir + row);

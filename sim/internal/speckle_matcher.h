@@ -66,6 +66,10 @@ class SpeckleMatcher {
   // repeat its first or last).
   // `weights`: scratch.
   float ScatteredPattern(float x, int v, float sigma_px, std::vector<float>& weights) const;
+  // Row v's dots (#width, DotsRow's) where scene.subsurface_m is above 0: ScatteredPattern at
+  // each pixel's point of the pattern. `weights`: scratch.
+  void ScatterDots(const SpeckleScene& scene, int v, float* dots,
+                   std::vector<float>& weights) const;
   int x_min() const { return x_min_; }
   // The integer disparity at which pixel p's search is centred (-1: nothing hit), from the
   // rendered disparity (as Match computes it).
