@@ -499,6 +499,31 @@ TemporalCorrelation AnalyseTemporalCorrelation(const std::vector<float>& a_m,
   return t;
 }
 
+std::vector<float> SurfaceAlignedDepth(const std::vector<float>& a_m, const std::vector<float>& b_m,
+                                       int width, int height, const PinholeIntrinsics& intrinsics,
+                                       const Rigid3& b_T_a) {
+  CheckDepthSize(a_m, width, height);
+  CheckDepthSize(b_m, width, height);
+  std::vector<float> out(a_m.size(), 0.0f);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const float z = a_m[static_cast<size_t>(v) * width + u];
+      if (!(z > 0)) continue;
+      const Eigen::Vector3d a_point(z * (u - intrinsics.cx) / intrinsics.fx,
+                                    z * (v - intrinsics.cy) / intrinsics.fy, z);
+      const Eigen::Vector3d b_point = b_T_a * a_point;
+      if (!(b_point.z() > 0)) continue;
+      const double ub = intrinsics.fx * b_point.x() / b_point.z() + intrinsics.cx;
+      const double vb = intrinsics.fy * b_point.y() / b_point.z() + intrinsics.cy;
+      const double iu = std::floor(ub + 0.5), iv = std::floor(vb + 0.5);
+      if (!(iu >= 0 && iu < width && iv >= 0 && iv < height)) continue;
+      out[static_cast<size_t>(v) * width + u] =
+          b_m[static_cast<size_t>(iv) * width + static_cast<size_t>(iu)];
+    }
+  }
+  return out;
+}
+
 nlohmann::json ToJson(const ErrorStructure& s) {
   return {{"missing_by_cause",
            {{"border", s.missing_border},

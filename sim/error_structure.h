@@ -35,6 +35,7 @@
 
 #include "core/camera.h"
 #include "core/image_io.h"
+#include "core/rigid3.h"
 #include "sim/kinect_model.h"
 #include "sim/structured_light.h"
 
@@ -102,6 +103,18 @@ TemporalCorrelation AnalyseTemporalCorrelation(const std::vector<float>& a_m,
                                                const std::vector<float>& b_m, int width,
                                                int height, const PinholeIntrinsics& intrinsics,
                                                const ErrorStructureOptions& options = {});
+
+// Frame b's depth along the surface frame a sees: each pixel of a with a depth, carried by the
+// camera's motion b_T_a (frame a's camera to frame b's) into b's image, takes the depth b
+// measured at the nearest pixel there; 0 where either misses or the point leaves b's image.
+// AnalyseTemporalCorrelation(a, SurfaceAlignedDepth(...)) then correlates the residuals at the
+// same points of the surface rather than at the same pixels: a block matcher's errors from the
+// projected pattern stay with the pixel (the projector moves with the camera), errors from the
+// surface itself (its texture in the IR, laser speckle) move with the surface. Both frames share
+// `intrinsics`.
+std::vector<float> SurfaceAlignedDepth(const std::vector<float>& a_m, const std::vector<float>& b_m,
+                                       int width, int height, const PinholeIntrinsics& intrinsics,
+                                       const Rigid3& b_T_a);
 
 // Why a pixel is missing, judged from the depth image alone (real frames carry no labels): runs of
 // missing pixels along a row touching the image's side (border), with the far side on their left

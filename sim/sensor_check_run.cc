@@ -55,18 +55,26 @@ struct StepRuns {
   }
 };
 
-// The first frame's residual correlation with the frames kTemporalLags later.
+// The first frame's residual correlation with the frames kTemporalLags later; with the camera's
+// motions (camera_k_T_camera_0 for every frame k, or none), also following the surface.
 SensorCheckReport::TemporalRow TemporalStructure(const std::string& name,
-                                                 const DepthSequence& sequence) {
-  SensorCheckReport::TemporalRow row{name, {}};
+                                                 const DepthSequence& sequence,
+                                                 const std::vector<Rigid3>& motions = {}) {
+  SensorCheckReport::TemporalRow row{name, {}, {}};
   for (const int lag : kTemporalLags) {
     if (lag >= static_cast<int>(sequence.depth_m.size())) {
       ThrowBadValue(sequence.name + ": frames", std::to_string(sequence.depth_m.size()),
                     "at least " + std::to_string(lag + 1) + " frames (the temporal structure)");
     }
-    row.lags.push_back(AnalyseTemporalCorrelation(sequence.depth_m[0], sequence.depth_m[lag],
-                                                  sequence.width, sequence.height,
-                                                  sequence.intrinsics));
+    const std::vector<float>& first = sequence.depth_m[0];
+    row.lags.push_back(AnalyseTemporalCorrelation(first, sequence.depth_m[lag], sequence.width,
+                                                  sequence.height, sequence.intrinsics));
+    if (motions.empty()) continue;
+    row.surface_lags.push_back(AnalyseTemporalCorrelation(
+        first,
+        SurfaceAlignedDepth(first, sequence.depth_m[lag], sequence.width, sequence.height,
+                            sequence.intrinsics, motions.at(lag)),
+        sequence.width, sequence.height, sequence.intrinsics));
   }
   return row;
 }
@@ -129,8 +137,10 @@ SensorStatistics RenderInMode(TableTopScene& table_top, const RenderConfig& conf
 // through the first frame's table fit, so a still object seen by camera_k = table_T_object_0
 // table_T_object_k^-1 table_T_camera has the real frame k's camera_T_object: the pattern slides
 // over the scene as in the real recording. `first_m`: frame 0, rendered already (the scene posed
-// at poses[0]).
-std::vector<SensorCheckReport::TemporalRow> ViewOverTime(const std::string& view_name,
+// at poses[0]). First, when the real view has the frames, its own row; the real and the moved rows
+// also following the surface, by the camera motions camera_k_T_camera_0 = table_T_camera_k^-1
+// table_T_camera.
+std::vector<SensorCheckReport::TemporalRow> ViewOverTime(const RealView& real,
                                                          const TableTopScene& scene,
                                                          KinectSensorOptions options,
                                                          const std::vector<Rigid3>& poses,
@@ -138,7 +148,7 @@ std::vector<SensorCheckReport::TemporalRow> ViewOverTime(const std::string& view
                                                          const PinholeIntrinsics& intrinsics) {
   const int lags = std::end(kTemporalLags)[-1] + 1;
   if (static_cast<int>(poses.size()) < lags) {
-    ThrowBadValue(view_name + ": render.trajectory", std::to_string(poses.size()) + " poses",
+    ThrowBadValue(real.name + ": render.trajectory", std::to_string(poses.size()) + " poses",
                   "at least " + std::to_string(lags) + " (the temporal lags)");
   }
   options.mode = SensorMode::kStructuredLight;
@@ -146,15 +156,26 @@ std::vector<SensorCheckReport::TemporalRow> ViewOverTime(const std::string& view
   DepthSequence moving{"view, SL, the real camera's motion", intrinsics.width, intrinsics.height,
                        intrinsics, {std::move(first_m)}};
   KinectSensor still_sensor(options, &scene.scene(), scene.table_T_camera());
+  std::vector<Rigid3> motions{Rigid3()};  // camera_k_T_camera_0
   for (int k = 1; k < lags; ++k) {
     const RgbdFrame frame = still_sensor.Render(k);
     still.depth_m.push_back(DepthMetresFromUnits(frame.depth, frame.depth_scale));
-    KinectSensor moved(options, &scene.scene(),
-                       poses.front() * poses[k].Inverse() * scene.table_T_camera());
+    const Rigid3 table_T_camera_k = poses.front() * poses[k].Inverse() * scene.table_T_camera();
+    motions.push_back(table_T_camera_k.Inverse() * scene.table_T_camera());
+    KinectSensor moved(options, &scene.scene(), table_T_camera_k);
     const RgbdFrame moved_frame = moved.Render(k);
     moving.depth_m.push_back(DepthMetresFromUnits(moved_frame.depth, moved_frame.depth_scale));
   }
-  return {TemporalStructure(still.name, still), TemporalStructure(moving.name, moving)};
+  std::vector<SensorCheckReport::TemporalRow> rows;
+  // The real view's own frames, the same motions (when it has enough).
+  if (real.later_frames.size() + 1 >= static_cast<size_t>(lags)) {
+    DepthSequence frames{real.name, real.width, real.height, real.intrinsics, {real.depth_m}};
+    for (int k = 1; k < lags; ++k) frames.depth_m.push_back(real.later_frames[k - 1].depth_m);
+    rows.push_back(TemporalStructure(real.name, frames, motions));
+  }
+  rows.push_back(TemporalStructure(still.name, still));
+  rows.push_back(TemporalStructure(moving.name, moving, motions));
+  return rows;
 }
 
 // A desk's front edge in a depth image of the bare geometry (width x height, metres, no pixel
@@ -420,8 +441,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
       report.view_step_laws.push_back(runs.Fit("view, stat.", focal, options));
     }
   }
-  report.view_temporal = ViewOverTime(view.name, scene, config.sensor, poses,
-                                      std::move(structured_depth_m), intrinsics);
+  report.view_temporal =
+      ViewOverTime(view, scene, config.sensor, poses, std::move(structured_depth_m), intrinsics);
   // Structured light over speckle patterns: the first is the row above.
   report.pattern_near.push_back(report.like_for_like.back().structure);
   if (!rendered_away.empty())
@@ -587,9 +608,11 @@ std::string SensorCheckReport::Format() const {
     for (const TemporalRow& row : rows) {
       std::snprintf(line, sizeof(line), "%-40s", row.name.c_str());
       text += line;
-      for (const TemporalCorrelation& t : row.lags) {
-        std::snprintf(line, sizeof(line), "  %14.3f (%5d)", t.rho, t.patches);
-        text += line;
+      for (const auto* lags : {&row.lags, &row.surface_lags}) {
+        for (const TemporalCorrelation& t : *lags) {
+          std::snprintf(line, sizeof(line), "  %14.3f (%5d)", t.rho, t.patches);
+          text += line;
+        }
       }
       text += "\n";
     }
@@ -597,7 +620,19 @@ std::string SensorCheckReport::Format() const {
   add_rows(temporal);
   if (!like_for_like.empty()) text += FormatLikeForLike() + FormatAnchors();
   if (!view_temporal.empty()) {
-    text += "\nthe real view over time: residual correlation with the first frame (as above)\n";
+    text +=
+        "\nthe real view over time: residual correlation with the first frame (as above; then "
+        "following the surface:\nframe k's depth where the point seen at each pixel of the "
+        "first moved with the camera)\n";
+    std::snprintf(line, sizeof(line), "%-40s", "sequence");
+    text += line;
+    for (const char* along : {"", "surface "}) {
+      for (const int lag : kTemporalLags) {
+        std::snprintf(line, sizeof(line), "  %slag %d: rho (windows)", along, lag);
+        text += line;
+      }
+    }
+    text += "\n";
     add_rows(view_temporal);
   }
   return text + FormatStepLaws();
@@ -922,9 +957,14 @@ nlohmann::json SensorCheckReport::ToJson() const {
     for (const TemporalRow& row : rows) {
       nlohmann::json lags = nlohmann::json::array();
       for (size_t k = 0; k < row.lags.size(); ++k) {
-        lags.push_back({{"lag_frames", kTemporalLags[k]},
-                        {"rho", row.lags[k].rho},
-                        {"windows", row.lags[k].patches}});
+        nlohmann::json lag = {{"lag_frames", kTemporalLags[k]},
+                              {"rho", row.lags[k].rho},
+                              {"windows", row.lags[k].patches}};
+        if (k < row.surface_lags.size()) {
+          lag["following_the_surface"] = {{"rho", row.surface_lags[k].rho},
+                                          {"windows", row.surface_lags[k].patches}};
+        }
+        lags.push_back(lag);
       }
       out.push_back({{"sequence", row.name}, {"lags", lags}});
     }

@@ -65,7 +65,7 @@ inline constexpr int kNeighbourhoodRadiusPx = 10;
 inline constexpr int kInteriorErosionPx = 5;
 
 // Frame lags of the temporal correlation (AnalyseTemporalCorrelation against the first frame).
-inline constexpr int kTemporalLags[] = {1, 4};
+inline constexpr int kTemporalLags[] = {1, 2, 4};
 
 // The step law (sim/step_law.h) of one sensor's frames, pooled: what geometry their missing
 // bands beside depth edges imply.
@@ -110,11 +110,15 @@ struct SensorCheckReport {
   struct TemporalRow {
     std::string name;
     std::vector<TemporalCorrelation> lags;  // one per kTemporalLags
+    // The same at the points of the surface rather than the pixels (SurfaceAlignedDepth, with the
+    // camera's motion between the frames); empty where the motion is not known.
+    std::vector<TemporalCorrelation> surface_lags;
   };
   std::vector<TemporalRow> temporal;
-  // The same for the like-for-like view in structured light (when a RealView is given): from a
-  // still camera, and moved as the real camera moved between the real frames (compare with the
-  // real sequence's row in `temporal`).
+  // The same for the like-for-like view (when a RealView is given): the real view's own frames
+  // (the sequence's first, as the real sequence's row in `temporal`, when it has enough), then
+  // structured light from a still camera and moved as the real camera moved between the real
+  // frames; the real and the moved rows also following the surface.
   std::vector<TemporalRow> view_temporal;
   // The step law of TUM, NYU (its raw frame is the IR camera's: kNyuDepthIntrinsics), the
   // kinect_sequence's frames (when given) and each rendered mode's frames of the demo walk (all

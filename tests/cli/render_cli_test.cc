@@ -410,16 +410,35 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   // Then the anchors from a still camera: ICL-NUIM's noise is new in every frame but for the raw
   // lattice (measured rho 0.08 / 0.09), simkinect keeps its fixed dot filter and its centimetre
   // terraces (0.54 / 0.58).
+  // First the real view's own frames: the real sequence's row again, at lags 1, 2 and 4.
+  // Following the surface (frame k's depth where the point seen at each pixel moved with the
+  // camera) the real and the moved rows persist less at lag 4 than at the same pixels (measured
+  // real 0.089 against 0.243, the model 0.148 against 0.610): in the device as in the model the
+  // persistent error stays with the pixel (the projected pattern), not with the surface.
   const nlohmann::json& view_temporal = json["view_temporal_correlation"];
-  ASSERT_EQ(view_temporal.size(), 4u);
-  EXPECT_EQ(view_temporal[2]["sequence"], "view, ICL-NUIM, still");
-  EXPECT_LT(view_temporal[2]["lags"][0]["rho"].get<double>(), 0.2);
+  ASSERT_EQ(view_temporal.size(), 5u);
+  const nlohmann::json& real_temporal = json["temporal_correlation"][0];
+  ASSERT_THAT(real_temporal["sequence"].get<std::string>(), HasSubstr("real YCB-Video"));
+  ASSERT_EQ(real_temporal["lags"].size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(view_temporal[0]["lags"][k]["rho"], real_temporal["lags"][k]["rho"]);
+  }
+  EXPECT_EQ(view_temporal[0]["lags"][2]["lag_frames"].get<int>(), 4);
+  EXPECT_EQ(view_temporal[3]["sequence"], "view, ICL-NUIM, still");
+  EXPECT_LT(view_temporal[3]["lags"][0]["rho"].get<double>(), 0.2);
   for (const auto& row : view_temporal) {
     for (const auto& lag : row["lags"]) EXPECT_GT(lag["windows"].get<int>(), 300) << row.dump();
   }
-  EXPECT_GT(view_temporal[0]["lags"][1]["rho"].get<double>(), 0.5);
-  EXPECT_LT(view_temporal[1]["lags"][1]["rho"].get<double>(),
-            view_temporal[0]["lags"][1]["rho"].get<double>() - 0.008);
+  EXPECT_GT(view_temporal[1]["lags"][2]["rho"].get<double>(), 0.5);
+  EXPECT_LT(view_temporal[2]["lags"][2]["rho"].get<double>(),
+            view_temporal[1]["lags"][2]["rho"].get<double>() - 0.008);
+  EXPECT_FALSE(view_temporal[1]["lags"][2].contains("following_the_surface"));
+  for (const int row : {0, 2}) {
+    const nlohmann::json& lag4 = view_temporal[row]["lags"][2];
+    EXPECT_GT(lag4["following_the_surface"]["windows"].get<int>(), 300) << lag4.dump();
+    EXPECT_LT(lag4["following_the_surface"]["rho"].get<double>(), lag4["rho"].get<double>() - 0.1)
+        << lag4.dump();
+  }
 
   // The second committed view: the foam brick with the box and the mug beside it.
   const fs::path ycbv = fs::path(MMH_SOURCE_DIR) / "tests/data/real/ycbv";

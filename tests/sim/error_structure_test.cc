@@ -291,6 +291,47 @@ TEST(ErrorStructure, TemporalCorrelationIsTheFixedShareOfTheResidualVariance) {
                InputError);
 }
 
+// A wall 1 m away seen from two camera positions 3 px apart (b moved along +x by 3 px at 1 m):
+// the point seen at pixel u in a is seen at u - 3 in b. Each frame has an error tied to the
+// surface S (sd 2 mm: it moves with the wall's points), one tied to the pixel P (1 mm: the
+// projected pattern's, which moves with the camera) and its own noise (1 mm). At the same pixels
+// the frames share P, var P / var = 1/6; following the surface they share S, 4/6.
+TEST(ErrorStructure, SurfaceAlignedDepthFollowsThePointsNotThePixels) {
+  std::mt19937 rng(12);
+  std::normal_distribution<double> unit(0.0, 0.001);
+  const PinholeIntrinsics intrinsics{kWidth, kHeight, 525.0, 525.0, 159.5, 119.5};
+  constexpr int kShift = 3;
+  // S over the wall's points, indexed by frame a's column (kShift more to the right for b's).
+  std::vector<double> surface((kWidth + kShift) * kHeight), pixel(kWidth * kHeight);
+  for (double& x : surface) x = 2 * unit(rng);
+  for (double& x : pixel) x = unit(rng);
+  std::vector<float> a(kWidth * kHeight), b(kWidth * kHeight);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      const int i = v * kWidth + u, s = v * (kWidth + kShift) + u;
+      a[i] = static_cast<float>(1.0 + surface[s] + pixel[i] + unit(rng));
+      b[i] = static_cast<float>(1.0 + surface[s + kShift] + pixel[i] + unit(rng));
+    }
+  }
+  const Rigid3 b_T_a(Eigen::Quaterniond::Identity(), Eigen::Vector3d(-kShift / 525.0, 0, 0));
+  a[7 * kWidth + 20] = 0.0f;  // missing in a: missing in the aligned frame
+  const std::vector<float> aligned = SurfaceAlignedDepth(a, b, kWidth, kHeight, intrinsics, b_T_a);
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      const int i = v * kWidth + u;
+      const float expected = (u < kShift || a[i] == 0.0f) ? 0.0f : b[i - kShift];
+      ASSERT_EQ(aligned[i], expected) << u << " " << v;
+    }
+  }
+  EXPECT_NEAR(AnalyseTemporalCorrelation(a, b, kWidth, kHeight, intrinsics).rho, 1.0 / 6, 0.03);
+  EXPECT_NEAR(AnalyseTemporalCorrelation(a, aligned, kWidth, kHeight, intrinsics).rho, 4.0 / 6,
+              0.03);
+  // No motion: the frame itself; a frame of the wrong size is refused.
+  EXPECT_EQ(SurfaceAlignedDepth(b, b, kWidth, kHeight, intrinsics, Rigid3()), b);
+  EXPECT_THROW(SurfaceAlignedDepth(a, std::vector<float>(10), kWidth, kHeight, intrinsics, b_T_a),
+               InputError);
+}
+
 // The interior: a 20 x 20 object whose outline ring is missing (the bands) and with three holes
 // on its surface, two of them inside the mask shrunk by 2 px (16 x 16 pixels), one on the ring's
 // inner side that the shrinking leaves out.
