@@ -406,6 +406,23 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     return ResampleDepthNearest(ResampleDepthNearest(depth_m, from, native), native, shown);
   };
   report.native_view_depth_m[0] = on_native_grid(view.depth_m, view.intrinsics);
+  // The small planar patches on the native grid (SensorCheckReport::view_patches): the real frames
+  // first.
+  auto native_patches = [&](const std::vector<float>& depth_m, const PinholeIntrinsics& from) {
+    return AnalyseErrorStructure(ResampleDepthNearest(depth_m, from, native), native.width,
+                                 native.height, native, config.sensor.calibration,
+                                 config.sensor.axial);
+  };
+  SensorCheckReport::PatchRow real_patches{view.name, {}};
+  real_patches.draws.push_back(native_patches(view.depth_m, view.intrinsics));
+  for (const RealView::Frame& frame : view.later_frames) {
+    real_patches.draws.push_back(native_patches(frame.depth_m, view.intrinsics));
+  }
+  report.view_patches = {
+      std::move(real_patches),
+      {"view, stat.", {}},
+      {"view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
+       {}}};
   scene.SetFrame(table_T_object, 0.0);
   std::vector<float> structured_depth_m;  // the structured-light frame, for the view over time
   StepRuns pattern_runs;                  // structured light over the patterns
@@ -432,6 +449,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     report.view_depth_m[structured ? 2 : 1] =
         ResampleDepthNearest(depth_m, intrinsics, view.intrinsics);
     report.native_view_depth_m[structured ? 2 : 1] = on_native_grid(depth_m, intrinsics);
+    report.view_patches[structured ? 2 : 1].draws.push_back(native_patches(depth_m, intrinsics));
     if (structured) {
       pattern_runs.Add(depth_m, width, height, focal);
       structured_depth_m = std::move(depth_m);
@@ -465,6 +483,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     }
     if (desk) report.pattern_desk.push_back(analyse_desk(depth_m));
     pattern_runs.Add(depth_m, width, height, focal);
+    report.view_patches[2].draws.push_back(native_patches(depth_m, intrinsics));
   }
   report.view_step_laws.push_back(pattern_runs.Fit(
       "view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
@@ -493,9 +512,11 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   const std::vector<float> clean = DepthMetresFromUnits(clean_frame.depth, clean_frame.depth_scale);
   for (const AnchorModel model : {AnchorModel::kIclNuim, AnchorModel::kSimKinect}) {
     SensorCheckReport::AnchorRows rows{AnchorName(model), {}, {}, {}};
+    SensorCheckReport::PatchRow patches{"view, " + AnchorName(model), {}};
     for (int k = 0; k < view.patterns; ++k) {
       const std::vector<float> depth_m =
           ApplyAnchorNoise(model, clean, width, height, config.sensor.seed + k, 0);
+      patches.draws.push_back(native_patches(depth_m, intrinsics));
       rows.near.push_back(AroundObject(depth_m, width, height, mask, kNeighbourhoodRadiusPx, 1.0));
       if (!rendered_away.empty()) {
         rows.away.push_back(
@@ -509,6 +530,7 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     }
     report.view_temporal.push_back(TemporalStructure(still.name, still));
     report.anchors.push_back(std::move(rows));
+    report.view_patches.push_back(std::move(patches));
   }
 }
 
@@ -618,7 +640,7 @@ std::string SensorCheckReport::Format() const {
     }
   };
   add_rows(temporal);
-  if (!like_for_like.empty()) text += FormatLikeForLike() + FormatAnchors();
+  if (!like_for_like.empty()) text += FormatLikeForLike() + FormatAnchors() + FormatViewPatches();
   if (!view_temporal.empty()) {
     text +=
         "\nthe real view over time: residual correlation with the first frame (as above; then "
@@ -943,6 +965,75 @@ std::string SensorCheckReport::FormatAnchors() const {
   return text;
 }
 
+namespace {
+
+// The statistics of the small-patch table (SensorCheckReport::view_patches).
+struct PatchStatistic {
+  const char* label;
+  const char* key;  // in sensor_check.json
+  double (*value)(const ErrorStructure&);
+};
+double FirstLag(const std::vector<double>& autocorrelation) {
+  return autocorrelation.empty() ? std::numeric_limits<double>::quiet_NaN() : autocorrelation[0];
+}
+constexpr PatchStatistic kPatchStatistics[] = {
+    {"small-patch noise / model", "noise_over_model",
+     [](const ErrorStructure& s) { return s.noise_over_model; }},
+    {"autocorrelation, lag 1", "autocorrelation_lag_1",
+     [](const ErrorStructure& s) { return FirstLag(s.autocorrelation); }},
+    {"... along the rows", "autocorrelation_lag_1_along_rows",
+     [](const ErrorStructure& s) { return FirstLag(s.autocorrelation_along_rows); }},
+    {"... along the columns", "autocorrelation_lag_1_along_columns",
+     [](const ErrorStructure& s) { return FirstLag(s.autocorrelation_along_columns); }},
+    {"correlation length [px]", "correlation_length_px",
+     [](const ErrorStructure& s) { return s.correlation_length_px; }},
+    {"planar windows", "windows",
+     [](const ErrorStructure& s) { return static_cast<double>(s.patches); }},
+};
+
+ValueSpread SpreadOf(const PatchStatistic& statistic, const std::vector<ErrorStructure>& draws) {
+  std::vector<double> values;
+  for (const ErrorStructure& s : draws) values.push_back(statistic.value(s));
+  return SpreadOfValues(values);
+}
+
+}  // namespace
+
+std::string SensorCheckReport::FormatViewPatches() const {
+  if (view_patches.empty()) return "";
+  const PatchRow& real = view_patches.front();
+  std::string text =
+      "\nlike for like, the view's small planar patches (9 x 9 windows; every frame on the "
+      "rendered sensor's pixel grid over the real\ncamera's field of view): mean over the real "
+      "frames, patterns or seeds (min-max), and its ratio to the real frames' mean\n";
+  char line[200];
+  std::snprintf(line, sizeof(line), "%-27s", "");
+  text += line;
+  for (const PatchRow& row : view_patches) {
+    std::snprintf(line, sizeof(line), " %27s",
+                  (row.name + " (" + std::to_string(row.draws.size()) + ")").c_str());
+    text += line;
+  }
+  text += "\n";
+  for (const PatchStatistic& statistic : kPatchStatistics) {
+    std::snprintf(line, sizeof(line), "%-27s", statistic.label);
+    text += line;
+    const ValueSpread r = SpreadOf(statistic, real.draws);
+    for (const PatchRow& row : view_patches) {
+      const ValueSpread v = SpreadOf(statistic, row.draws);
+      if (&row == &real) {
+        std::snprintf(line, sizeof(line), " %12.3f (%.3f-%.3f)", v.mean, v.min, v.max);
+      } else {
+        std::snprintf(line, sizeof(line), " %8.3f (%.2f-%.2f) %5.2f", v.mean, v.min, v.max,
+                      v.mean / r.mean);
+      }
+      text += line;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
 nlohmann::json SensorCheckReport::ToJson() const {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& c : columns) j.push_back(sim::ToJson(c));
@@ -1085,6 +1176,23 @@ nlohmann::json SensorCheckReport::ToJson() const {
       out.push_back(entry);
     }
     result["like_for_like_anchors"] = out;
+  }
+  if (!view_patches.empty()) {
+    // Per row its draws' structures, the means and the ratios of the means to the real frames'.
+    nlohmann::json out = nlohmann::json::array();
+    for (const PatchRow& row : view_patches) {
+      nlohmann::json draws = nlohmann::json::array();
+      for (const ErrorStructure& s : row.draws) draws.push_back(sim::ToJson(s));
+      nlohmann::json means = nlohmann::json::object(), ratios = nlohmann::json::object();
+      for (const PatchStatistic& statistic : kPatchStatistics) {
+        means[statistic.key] = SpreadOf(statistic, row.draws).mean;
+        ratios[statistic.key] =
+            means[statistic.key].get<double>() / SpreadOf(statistic, view_patches[0].draws).mean;
+      }
+      out.push_back(
+          {{"source", row.name}, {"draws", draws}, {"mean", means}, {"ratio_of_means", ratios}});
+    }
+    result["like_for_like_small_patches"] = out;
   }
   auto step_law_rows = [](const std::vector<StepLawRow>& rows) {
     auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); };

@@ -175,6 +175,19 @@ struct SensorCheckReport {
   int native_view_width = 0, native_view_height = 0;
   std::vector<float> native_view_depth_m[3];
 
+  // The view's small planar patches like for like (AnalyseErrorStructure's small-patch noise, the
+  // residuals' autocorrelation and its length; docs/sensor.md, "Small patches like for like"):
+  // every frame on the rendered sensor's pixel grid over the real camera's field of view (the real
+  // frames resampled down to it, the rendered ones cut to it), so that both are sampled alike and
+  // cover the same part of the scene. One row per source, one structure per draw: the real frames
+  // (the first and later_frames), the view rendered statistically, in structured light per
+  // pattern (pattern_seeds) and by each anchor per noise seed.
+  struct PatchRow {
+    std::string name;
+    std::vector<ErrorStructure> draws;
+  };
+  std::vector<PatchRow> view_patches;
+
   // The published noise models issue 23 names as anchors (sim/anchor_noise.h: ICL-NUIM and
   // simkinect), applied to the exact render: the demo walk's first frame's error structure is in
   // `structures` after the two modes ("anchor ICL-NUIM", "anchor simkinect"); with a RealView, per
@@ -192,6 +205,7 @@ struct SensorCheckReport {
   std::string Format() const;
   std::string FormatLikeForLike() const;
   std::string FormatAnchors() const;
+  std::string FormatViewPatches() const;
   std::string FormatStepLaws() const;
   std::string FormatNeighbourhoods(
       const std::string& title, const std::vector<NeighbourhoodRow>& rows,

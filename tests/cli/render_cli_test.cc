@@ -440,6 +440,34 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
         << lag4.dump();
   }
 
+  // The view's small planar patches like for like, every frame on the rendered sensor's pixel grid
+  // over the real camera's field of view: the real frames 1-10, the statistical view, structured
+  // light over the 8 patterns, the anchors over 8 noise seeds. The statistical sensor draws each
+  // pixel's noise from the per-pixel model the noise is divided by, so on planes its small-patch
+  // noise is the model's and its residuals are not correlated; the real device's are, and so are
+  // structured light's (block matching).
+  const nlohmann::json& patches = json["like_for_like_small_patches"];
+  ASSERT_EQ(patches.size(), 5u);
+  EXPECT_EQ(patches[0]["draws"].size(), 10u);
+  EXPECT_EQ(patches[1]["source"], "view, stat.");
+  EXPECT_EQ(patches[1]["draws"].size(), 1u);
+  EXPECT_EQ(patches[2]["draws"].size(), 8u);
+  EXPECT_EQ(patches[3]["source"], "view, ICL-NUIM");
+  EXPECT_EQ(patches[4]["draws"].size(), 8u);
+  for (const auto& row : patches) {
+    // (simkinect's centimetre terraces leave about 170 planar windows, the others 450-600.)
+    for (const auto& draw : row["draws"])
+      EXPECT_GT(draw["patches"].get<int>(), 100) << row["source"];
+    const double real_noise = patches[0]["mean"]["noise_over_model"].get<double>();
+    EXPECT_NEAR(row["ratio_of_means"]["noise_over_model"].get<double>(),
+                row["mean"]["noise_over_model"].get<double>() / real_noise, 1e-12);
+  }
+  EXPECT_NEAR(patches[1]["mean"]["noise_over_model"].get<double>(), 1.0, 0.15);
+  EXPECT_LT(std::abs(patches[1]["mean"]["autocorrelation_lag_1"].get<double>()), 0.1);
+  EXPECT_GT(patches[0]["mean"]["autocorrelation_lag_1"].get<double>(), 0.3);
+  EXPECT_GT(patches[2]["mean"]["autocorrelation_lag_1"].get<double>(), 0.3);
+  EXPECT_THAT(r.output, HasSubstr("like for like, the view's small planar patches"));
+
   // The second committed view: the foam brick with the box and the mug beside it.
   const fs::path ycbv = fs::path(MMH_SOURCE_DIR) / "tests/data/real/ycbv";
   const auto brick = RunMmh(
