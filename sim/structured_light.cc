@@ -27,6 +27,15 @@ void StructuredLightOptions::Validate(const std::string& prefix) const {
   if (!std::isfinite(dot_sigma_px) || dot_sigma_px < 0.2 || dot_sigma_px > 3) {
     ThrowBadValue(prefix + ".dot_sigma_px", FormatNumber(dot_sigma_px), "a dot size in [0.2, 3] px");
   }
+  if (!std::isfinite(faint_dot_density) || faint_dot_density < 0 || faint_dot_density > 2) {
+    ThrowBadValue(prefix + ".faint_dot_density", FormatNumber(faint_dot_density),
+                  "faint dots per pixel in [0, 2] (0: none)");
+  }
+  if (!std::isfinite(faint_dot_brightness) || faint_dot_brightness <= 0 ||
+      faint_dot_brightness > 1) {
+    ThrowBadValue(prefix + ".faint_dot_brightness", FormatNumber(faint_dot_brightness),
+                  "a fraction of the bright dots' brightness in (0, 1]");
+  }
   RequirePositive(projector_power, prefix + ".projector_power");
   RequireNonNegative(ambient, prefix + ".ambient");
   RequireNonNegative(read_noise, prefix + ".read_noise");

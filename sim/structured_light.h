@@ -41,6 +41,12 @@ struct StructuredLightOptions {
   double dot_density = 0.11;
   double dot_sigma_px = 0.6;
   uint64_t pattern_seed = 20100604;
+  // A second population of faint dots between the bright ones (0: none), of the same size, each
+  // of faint_dot_brightness times a brightness uniform in [0.5, 1]: a texture denser than the
+  // bright dots under each window, which sets how far a match on a slanted surface strays from the
+  // window's centre (docs/sensor.md, "Small patches like for like").
+  double faint_dot_density = 0.0;
+  double faint_dot_brightness = 0.2;
   // The IR image, full scale 1: a dot of brightness 1 on a white Lambertian surface facing the
   // camera at 1 m peaks at projector_power (fall-off 1 / z^2), ambient IR light reflected by the
   // surface adds ambient * albedo; sensor noise sigma^2 = read_noise^2 + shot_gain * value;
@@ -109,6 +115,8 @@ struct StructuredLightOptions {
     v("dot_density", dot_density);
     v("dot_sigma_px", dot_sigma_px);
     v("pattern_seed", pattern_seed);
+    v("faint_dot_density", faint_dot_density);
+    v("faint_dot_brightness", faint_dot_brightness);
     v("projector_power", projector_power);
     v("ambient", ambient);
     v("read_noise", read_noise);

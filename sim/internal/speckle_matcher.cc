@@ -431,34 +431,41 @@ SpeckleMatcher::SpeckleMatcher(const StructuredLightOptions& options, int width,
   pattern_.assign(static_cast<size_t>(height) * samples_, 0.0f);
 
   // Dots at random positions over the pattern's extent (plus a margin for their tails), each a
-  // Gaussian of dot_sigma_px with a brightness uniform in [0.5, 1]; added in dot order, so the
-  // pattern is the same on every machine and thread count.
+  // Gaussian of dot_sigma_px with a brightness uniform in [0.5, 1] (times `scale`); added in dot
+  // order, the bright ones first, so the pattern is the same on every machine and thread count
+  // (and without faint dots the same as before they existed).
   const double sigma = options.dot_sigma_px;
   const double reach = 3.0 * sigma;
   const double x0 = x_min_ - reach, x1 = x_max + reach;
   const double y0 = -reach, y1 = height + reach;
-  const auto dots =
-      static_cast<uint64_t>(std::llround(options.dot_density * (x1 - x0) * (y1 - y0)));
   const double inverse_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
-  for (uint64_t i = 0; i < dots; ++i) {
-    const uint64_t key = Mix64(options.pattern_seed ^ Mix64(3 * i + 0x9E3779B97F4A7C15ULL));
-    const double x = x0 + (x1 - x0) * Uniform(key);
-    const double y = y0 + (y1 - y0) * Uniform(Mix64(key + 1));
-    const double brightness = 0.5 + 0.5 * Uniform(Mix64(key + 2));
-    const int row_first = std::max(0, static_cast<int>(std::ceil(y - reach)));
-    const int row_last = std::min(height - 1, static_cast<int>(std::floor(y + reach)));
-    const int k_first =
-        std::max(0, static_cast<int>(std::ceil((x - reach - x_min_) * kSubsamples)));
-    const int k_last =
-        std::min(samples_ - 1, static_cast<int>(std::floor((x + reach - x_min_) * kSubsamples)));
-    for (int r = row_first; r <= row_last; ++r) {
-      const double wy = brightness * std::exp(-(r - y) * (r - y) * inverse_two_sigma2);
-      float* row = &pattern_[static_cast<size_t>(r) * samples_];
-      for (int k = k_first; k <= k_last; ++k) {
-        const double dx = x_min_ + static_cast<double>(k) / kSubsamples - x;
-        row[k] += static_cast<float>(wy * std::exp(-dx * dx * inverse_two_sigma2));
+  auto add_dots = [&](double density, double scale, uint64_t stream) {
+    const auto dots = static_cast<uint64_t>(std::llround(density * (x1 - x0) * (y1 - y0)));
+    for (uint64_t i = 0; i < dots; ++i) {
+      const uint64_t key =
+          Mix64(options.pattern_seed ^ Mix64(3 * i + 0x9E3779B97F4A7C15ULL) ^ stream);
+      const double x = x0 + (x1 - x0) * Uniform(key);
+      const double y = y0 + (y1 - y0) * Uniform(Mix64(key + 1));
+      const double brightness = scale * (0.5 + 0.5 * Uniform(Mix64(key + 2)));
+      const int row_first = std::max(0, static_cast<int>(std::ceil(y - reach)));
+      const int row_last = std::min(height - 1, static_cast<int>(std::floor(y + reach)));
+      const int k_first =
+          std::max(0, static_cast<int>(std::ceil((x - reach - x_min_) * kSubsamples)));
+      const int k_last =
+          std::min(samples_ - 1, static_cast<int>(std::floor((x + reach - x_min_) * kSubsamples)));
+      for (int r = row_first; r <= row_last; ++r) {
+        const double wy = brightness * std::exp(-(r - y) * (r - y) * inverse_two_sigma2);
+        float* row = &pattern_[static_cast<size_t>(r) * samples_];
+        for (int k = k_first; k <= k_last; ++k) {
+          const double dx = x_min_ + static_cast<double>(k) / kSubsamples - x;
+          row[k] += static_cast<float>(wy * std::exp(-dx * dx * inverse_two_sigma2));
+        }
       }
     }
+  };
+  add_dots(options.dot_density, 1.0, 0);
+  if (options.faint_dot_density > 0) {
+    add_dots(options.faint_dot_density, options.faint_dot_brightness, 0xFA1D07F00D5EEDULL);
   }
 
   // The reference image: the pattern at integer columns, captured by the same camera (ADC
