@@ -435,6 +435,7 @@ ErrorStructure AnalyseErrorStructure(const std::vector<float>& depth_m, int widt
   s.noise_over_model = Median(ratios);
   for (int b = 0; b < ErrorStructure::kIncidenceBins; ++b) {
     s.noise_over_model_by_incidence[b] = Median(ratios_by_incidence[b]);
+    s.patches_by_incidence[b] = static_cast<int>(ratios_by_incidence[b].size());
   }
   s.autocorrelation.assign(lags, kNaN);
   s.autocorrelation_along_rows.assign(lags, kNaN);
@@ -538,6 +539,7 @@ nlohmann::json ToJson(const ErrorStructure& s) {
           {"patches", s.patches},
           {"noise_over_model", s.noise_over_model},
           {"noise_over_model_by_incidence_0_20_40_60_deg", s.noise_over_model_by_incidence},
+          {"patches_by_incidence_0_20_40_60_deg", s.patches_by_incidence},
           {"autocorrelation", s.autocorrelation},
           {"autocorrelation_along_rows", s.autocorrelation_along_rows},
           {"autocorrelation_along_columns", s.autocorrelation_along_columns},

@@ -70,6 +70,7 @@ struct ErrorStructure {
   static constexpr int kIncidenceBins = 3;
   static constexpr double kIncidenceBinDeg = 20.0;
   std::array<double, kIncidenceBins> noise_over_model_by_incidence{};
+  std::array<int, kIncidenceBins> patches_by_incidence{};  // the windows in each
   std::vector<double> autocorrelation;  // rho(1) .. rho(patch_size / 2)
   // The same along the rows (horizontal lags, the direction the matcher searches) and along the
   // columns alone: a block matcher's window shape shows in their ratio.

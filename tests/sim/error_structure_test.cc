@@ -196,6 +196,10 @@ TEST(ErrorStructure, ResidualAutocorrelationOfWhiteAndSmoothedNoise) {
   EXPECT_EQ(white.noise_over_model_by_incidence[0], white.noise_over_model);
   EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[1]));
   EXPECT_TRUE(std::isnan(white.noise_over_model_by_incidence[2]));
+  // Every window of the facing wall in the first bin, none in the others.
+  EXPECT_EQ(white.patches_by_incidence[0], white.patches);
+  EXPECT_EQ(white.patches_by_incidence[1], 0);
+  EXPECT_EQ(white.patches_by_incidence[2], 0);
 }
 
 // Noise averaged along the rows only (3 pixels side by side): correlated along the rows, not
