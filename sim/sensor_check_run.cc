@@ -418,11 +418,10 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
   for (const RealView::Frame& frame : view.later_frames) {
     real_patches.draws.push_back(native_patches(frame.depth_m, view.intrinsics));
   }
+  const std::string structured_over_patterns =
+      "view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : "");
   report.view_patches = {
-      std::move(real_patches),
-      {"view, stat.", {}},
-      {"view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
-       {}}};
+      std::move(real_patches), {"view, stat.", {}}, {structured_over_patterns, {}}};
   scene.SetFrame(table_T_object, 0.0);
   std::vector<float> structured_depth_m;  // the structured-light frame, for the view over time
   StepRuns pattern_runs;                  // structured light over the patterns
@@ -485,9 +484,8 @@ void CompareLikeForLike(const RealView& view, SensorCheckReport& report) {
     pattern_runs.Add(depth_m, width, height, focal);
     report.view_patches[2].draws.push_back(native_patches(depth_m, intrinsics));
   }
-  report.view_step_laws.push_back(pattern_runs.Fit(
-      "view, SL, " + std::to_string(view.patterns) + " pattern" + (view.patterns > 1 ? "s" : ""),
-      focal, config.sensor));
+  report.view_step_laws.push_back(
+      pattern_runs.Fit(structured_over_patterns, focal, config.sensor));
   // Matched on the other grid than the config's (StructuredLightOptions::match_on_ir_grid): the
   // IR camera's, registered to the colour camera's, or the delivered one (the shortcut).
   report.other_grid_is_ir = !config.sensor.structured_light.match_on_ir_grid;
@@ -1180,14 +1178,18 @@ nlohmann::json SensorCheckReport::ToJson() const {
   if (!view_patches.empty()) {
     // Per row its draws' structures, the means and the ratios of the means to the real frames'.
     nlohmann::json out = nlohmann::json::array();
+    std::vector<double> real_means;
+    for (const PatchStatistic& statistic : kPatchStatistics) {
+      real_means.push_back(SpreadOf(statistic, view_patches.front().draws).mean);
+    }
     for (const PatchRow& row : view_patches) {
       nlohmann::json draws = nlohmann::json::array();
       for (const ErrorStructure& s : row.draws) draws.push_back(sim::ToJson(s));
       nlohmann::json means = nlohmann::json::object(), ratios = nlohmann::json::object();
-      for (const PatchStatistic& statistic : kPatchStatistics) {
-        means[statistic.key] = SpreadOf(statistic, row.draws).mean;
-        ratios[statistic.key] =
-            means[statistic.key].get<double>() / SpreadOf(statistic, view_patches[0].draws).mean;
+      for (size_t k = 0; k < std::size(kPatchStatistics); ++k) {
+        const double mean = SpreadOf(kPatchStatistics[k], row.draws).mean;
+        means[kPatchStatistics[k].key] = mean;
+        ratios[kPatchStatistics[k].key] = mean / real_means[k];
       }
       out.push_back(
           {{"source", row.name}, {"draws", draws}, {"mean", means}, {"ratio_of_means", ratios}});
