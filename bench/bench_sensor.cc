@@ -35,13 +35,18 @@ struct Setup {
   std::unique_ptr<mmh::sim::KinectSensor> sensor;
 
   // sensor: 0 statistical, 1 structured light, 2 structured light matched on the IR camera's
-  // grid and registered (StructuredLightOptions::match_on_ir_grid).
+  // grid and registered (StructuredLightOptions::match_on_ir_grid), 3 and 4 structured light with
+  // slanted windows to first order and sheared (StructuredLightOptions::slanted_windows).
   explicit Setup(int sensor_mode = 0) {
     config.scene.props = mmh::sim::TableProps::kCastle;
     // Both modes set explicitly: structured light is the default since 2026-11-29.
     config.sensor.mode = sensor_mode > 0 ? mmh::sim::SensorMode::kStructuredLight
                                          : mmh::sim::SensorMode::kStatistical;
     config.sensor.structured_light.match_on_ir_grid = sensor_mode == 2;
+    config.sensor.structured_light.slanted_windows =
+        sensor_mode == 3   ? mmh::sim::SlantedWindows::kFirstOrder
+        : sensor_mode == 4 ? mmh::sim::SlantedWindows::kSheared
+                           : mmh::sim::SlantedWindows::kOff;
     scene = std::make_unique<mmh::sim::TableTopScene>(config, mmh::sim::LoadProxyModel("", 1.0));
     sensor = std::make_unique<mmh::sim::KinectSensor>(config.sensor, &scene->scene(),
                                                       scene->table_T_camera());
@@ -54,9 +59,9 @@ struct Setup {
 };
 
 // sensor_mode: Setup's (1: the structured-light mode, speckle image and block matching; 2: matched
-// on the IR camera's grid).
+// on the IR camera's grid; 3, 4: slanted windows to first order, sheared).
 Setup& SoldierScene(int worker, int sensor_mode = 0) {
-  static std::vector<std::unique_ptr<Setup>> setups[3];
+  static std::vector<std::unique_ptr<Setup>> setups[5];
   auto& list = setups[sensor_mode];
   while (static_cast<int>(list.size()) <= worker) {
     list.push_back(std::make_unique<Setup>(sensor_mode));
@@ -82,7 +87,7 @@ void Report(benchmark::State& state, const mmh::sim::SensorTimings& t, double fr
 // Args: mode (0 incremental, 1 full), threads (1: one core; 0: all, parallel within the frame),
 // sensor mode (0 statistical, 1 structured light).
 void BM_SensorFrame(benchmark::State& state) {
-  Setup& s = SoldierScene(0, state.range(2) == 1);
+  Setup& s = SoldierScene(0, static_cast<int>(state.range(2)));
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
   std::unique_ptr<tbb::global_control> limit;
   if (state.range(1) > 0) {
@@ -128,13 +133,16 @@ BENCHMARK(BM_SensorFrame)
     ->Args({1, 1, 0})
     ->Args({1, 0, 1})
     ->Args({1, 1, 1})
+    ->Args({1, 0, 3})
+    ->Args({1, 0, 4})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 // Frame-level parallelism (mmh::sim::RenderFrames): one scene and sensor per worker, 120 frames
 // of the demo walk per iteration. Args: mode, workers, cores (0: all; 1: everything on one
 // thread, as one job of the pipeline renders its session), sensor mode (1: structured light; 2:
-// structured light matched on the IR camera's grid and registered).
+// structured light matched on the IR camera's grid and registered; 3, 4: structured light with
+// slanted windows to first order, sheared).
 void BM_SensorFrames(benchmark::State& state) {
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
   std::unique_ptr<tbb::global_control> limit;
@@ -174,6 +182,9 @@ BENCHMARK(BM_SensorFrames)
     ->Args({1, 2, 0, 1})
     ->Args({0, 2, 0, 2})
     ->Args({1, 2, 0, 2})
+    ->Args({0, 2, 0, 3})
+    ->Args({1, 2, 0, 3})
+    ->Args({1, 2, 0, 4})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -13,10 +13,20 @@ constexpr std::array<std::pair<SensorMode, const char*>, 2> kSensorModeNames = {
     {SensorMode::kStructuredLight, "structured_light"},
 }};
 
+constexpr std::array<std::pair<SlantedWindows, const char*>, 3> kSlantedWindowsNames = {{
+    {SlantedWindows::kOff, "off"},
+    {SlantedWindows::kFirstOrder, "first_order"},
+    {SlantedWindows::kSheared, "sheared"},
+}};
+
 }  // namespace
 
 std::span<const std::pair<SensorMode, const char*>> EnumNames(SensorMode) {
   return kSensorModeNames;
+}
+
+std::span<const std::pair<SlantedWindows, const char*>> EnumNames(SlantedWindows) {
+  return kSlantedWindowsNames;
 }
 
 void StructuredLightOptions::Validate(const std::string& prefix) const {

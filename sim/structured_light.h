@@ -34,6 +34,20 @@ enum class MissingCause : uint8_t {
   kRange,         // outside the lattice or [min_depth, max_depth]
 };
 
+// StructuredLightOptions::slanted_windows (config names "off", "first_order", "sheared").
+enum class SlantedWindows {
+  kOff,  // the first match's disparity
+  // The first match's disparity minus g . c, c from the reference pattern at that disparity (its
+  // squared horizontal derivative's centroid under the window, tabulated per row, column and
+  // 1/8 px phase): the sheared match to first order, at a table lookup per pixel.
+  kFirstOrder,
+  // The window matched again against the pattern sheared by g (window pixel (i, j) against the
+  // pattern at column u + i - d - g_u i - g_v j, linear between its 1/8 px samples), the peak's
+  // three-point Gaussian fit: exact, and about 12 times slower than the whole frame without it.
+  kSheared,
+};
+std::span<const std::pair<SlantedWindows, const char*>> EnumNames(SlantedWindows);
+
 struct StructuredLightOptions {
   // The speckle pattern, fixed per device: dots at random positions (density per IR pixel; the
   // Kinect v1 projects about 34 000 dots, 0.11 per pixel of its 640 x 480 image), each a Gaussian
@@ -87,6 +101,13 @@ struct StructuredLightOptions {
   // per-pixel search costs about 6 times the IR image and matching step; requires
   // subpixel_steps 8 (the pattern's sampling).
   bool lattice_search = false;
+  // How a match on a slanted surface is refined (docs/sensor.md, "Slanted windows"). On a
+  // surface whose disparity changes across the window by (g_u, g_v) [px/px], a match of the
+  // window as one disparity strays from the centre's by g . c, c the centroid of the pattern's
+  // horizontal detail under the window (about |g| / sqrt(12 rho) px, rho dots per pixel, whatever
+  // the window's size). A plane fitted to the first match's disparities under the window gives g.
+  // Skipped where parabola_subpixel is false.
+  SlantedWindows slanted_windows = SlantedWindows::kOff;
   // Match windows centred in the projector's shadow like any other, so that the correlation
   // decides (a window whose lit part correlates keeps its depth, as on the device, which does not
   // know where the shadow is; docs/sensor.md, "The step law of the bands"); false rejects them
@@ -132,6 +153,7 @@ struct StructuredLightOptions {
     v("edge_candidates", edge_candidates);
     v("parabola_subpixel", parabola_subpixel);
     v("lattice_search", lattice_search);
+    v("slanted_windows", slanted_windows);
     v("match_in_shadow", match_in_shadow);
     v("match_on_ir_grid", match_on_ir_grid);
     v("registration_growth_px", registration_growth_px);

@@ -674,6 +674,13 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
       std::fill_n(cause + static_cast<size_t>(v) * width_, width_, MissingCause::kBorder);
     }
   }
+  const bool slanted =
+      options_.slanted_windows != SlantedWindows::kOff && options_.parabola_subpixel;
+  if (slanted) {
+    if (options_.slanted_windows == SlantedWindows::kFirstOrder) PrepareCentroids();
+    frame_code_.assign(pixels, static_cast<int>(MissingCause::kBorder));
+    frame_disparity_.assign(pixels, 0.0f);
+  }
   const int bands = (height_ - 2 * rad + kBand - 1) / kBand;
   // Every band overwrites what it reads of its scratch: which worker's scratch a band gets does
   // not change its bytes.
@@ -684,9 +691,18 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
     BandScratch& scratch = *slot;
     for (int b = r.begin(); b != r.end(); ++b) {
       const int v0 = rad + b * kBand;
-      MatchBand(scene, output, v0, std::min(v0 + kBand, height_ - rad), scratch, depth, cause);
+      MatchBand(scene, output, v0, std::min(v0 + kBand, height_ - rad), scratch, depth, cause,
+                slanted ? frame_code_.data() : nullptr,
+                slanted ? frame_disparity_.data() : nullptr);
     }
   });
+  if (!slanted) return;
+  // The second pass needs the first match's disparities under every window: after all bands.
+  // Its sums are exact integers, so where a task starts does not change them.
+  tbb::parallel_for(tbb::blocked_range<int>(rad, height_ - rad, kBand),
+                    [&](const tbb::blocked_range<int>& r) {
+                      RefineSlantedRows(output, r.begin(), r.end(), depth, cause);
+                    });
 }
 
 void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
@@ -722,7 +738,8 @@ void SpeckleMatcher::PrepareRow(int v, int r, BandScratch& s) const {
 }
 
 void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& output, int v0,
-                               int v1, BandScratch& s, uint16_t* depth, MissingCause* cause) const {
+                               int v1, BandScratch& s, uint16_t* depth, MissingCause* cause,
+                               int* first_code, float* first_disparity) const {
   const int w = width_;
   const int rad = radius_;
   const int window = options_.window_px;
@@ -837,11 +854,285 @@ void SpeckleMatcher::MatchBand(const SpeckleScene& scene, const SpeckleOutput& o
         SearchLattice(output, v, start, span, s.code.data(), s.best_d.data(), &s.sum[at + start],
                       &s.inverse_norm[at + start], s.disparity.data());
       }
+      if (first_code != nullptr) {
+        std::copy_n(s.code.data(), span, first_code + static_cast<size_t>(v) * w + start);
+        std::copy_n(s.disparity.data(), span, first_disparity + static_cast<size_t>(v) * w + start);
+        continue;
+      }
       Output(output, s.code.data(), s.disparity.data(), span,
              depth + static_cast<size_t>(v) * w + start,
              cause != nullptr ? cause + static_cast<size_t>(v) * w + start : nullptr);
     }
   }
+}
+
+double SpeckleMatcher::SlantedScore(int u, int v, double d, double g_u, double g_v, double sum,
+                                    double inverse_norm) const {
+  const int rad = radius_;
+  const int stride = width_ + kBlock;
+  const double last = samples_ - 2;
+  double cross = 0, reference_sum = 0, reference_square = 0;
+  for (int j = -rad; j <= rad; ++j) {
+    const float* pattern = &pattern_[static_cast<size_t>(v + j) * samples_];
+    const int32_t* ir = &wide_ir_[static_cast<size_t>(v + j) * stride + (u - rad)];
+    // Window pixel (u + i, v + j) sees the pattern at column u + i - d - g_u i - g_v j.
+    const double row_start = u - d - g_v * j - x_min_;
+    for (int i = -rad; i <= rad; ++i) {
+      double position = (row_start + i * (1.0 - g_u)) * kSubsamples;
+      position = std::clamp(position, 0.0, last);
+      const int k = static_cast<int>(position);
+      const double t = position - k;
+      const double b = pattern[k] + t * (pattern[k + 1] - pattern[k]);
+      cross += ir[i + rad] * b;
+      reference_sum += b;
+      reference_square += b * b;
+    }
+  }
+  const double n = static_cast<double>(options_.window_px) * options_.window_px;
+  const double norm2 = n * reference_square - reference_sum * reference_sum;
+  if (!(norm2 > 0) || !(inverse_norm > 0)) return -std::numeric_limits<double>::infinity();
+  return (n * cross - sum * reference_sum) * inverse_norm / std::sqrt(norm2);
+}
+
+void SpeckleMatcher::PrepareCentroids() {
+  if (!centroids_.empty()) return;
+  const int rad = radius_;
+  centroid_units_ = std::floor(127.0 / rad);
+  centroids_.assign(2 * static_cast<size_t>(height_) * columns_ * kSubsamples, 0);
+  const int half = kSubsamples / 2;
+  // Each (phase, row) from its own sums in a fixed order: the same for any thread count.
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, kSubsamples * height_), [&](const tbb::blocked_range<int>& r) {
+        std::vector<double> column(columns_), column_j(columns_);
+        for (int task = r.begin(); task != r.end(); ++task) {
+          const int q = task / height_, v = task % height_;
+          // Down each column: the weight W = (P(k + 1/2 px) - P(k - 1/2 px))^2 at sample k = 8 c +
+          // q, and W j, over the window's rows inside the image.
+          std::fill(column.begin(), column.end(), 0.0);
+          std::fill(column_j.begin(), column_j.end(), 0.0);
+          for (int j = -rad; j <= rad; ++j) {
+            if (v + j < 0 || v + j >= height_) continue;
+            const float* pattern = &pattern_[static_cast<size_t>(v + j) * samples_];
+            for (int c = 0; c < columns_; ++c) {
+              const int k = c * kSubsamples + q;
+              const double slope =
+                  pattern[std::min(k + half, samples_ - 1)] - pattern[std::max(k - half, 0)];
+              column[c] += slope * slope;
+              column_j[c] += slope * slope * j;
+            }
+          }
+          for (int c = 0; c < columns_; ++c) {
+            double w = 0, w_i = 0, w_j = 0;
+            for (int i = std::max(-rad, -c); i <= std::min(rad, columns_ - 1 - c); ++i) {
+              w += column[c + i];
+              w_i += column[c + i] * i;
+              w_j += column_j[c + i];
+            }
+            if (!(w > 0)) continue;
+            int8_t* out =
+                &centroids_[2 * ((static_cast<size_t>(v) * columns_ + c) * kSubsamples + q)];
+            out[0] = static_cast<int8_t>(std::lround(centroid_units_ * w_i / w));
+            out[1] = static_cast<int8_t>(std::lround(centroid_units_ * w_j / w));
+          }
+        }
+      });
+}
+
+void SpeckleMatcher::RefineSlantedRows(const SpeckleOutput& output, int v0, int v1, uint16_t* depth,
+                                       MissingCause* cause) const {
+  // A plane fit is trusted where it rests on at least half the window and its rms residual is
+  // below kMaxResidualPx (a window across a depth edge fits two surfaces badly), its gradient
+  // below kMaxGradient [px/px] (about 80 degrees of incidence at 0.75 m).
+  constexpr double kMaxResidualPx = 0.5;
+  constexpr double kMaxGradient = 0.5;
+  // Disparities in 1/kFixed px, so that every sum below is an exact integer.
+  constexpr int kFixedInt = 1024;
+  constexpr double kFixed = kFixedInt;
+  const int w = width_;
+  const int rad = radius_;
+  const double n = static_cast<double>(options_.window_px) * options_.window_px;
+  const bool first_order = options_.slanted_windows == SlantedWindows::kFirstOrder;
+  // Down each column over rows y of the window: the matched pixels' count m, sum y, sum y^2, and
+  // of their fixed-point disparities q: sum q, sum q y, sum q^2 (kept as the window slides down).
+  enum { kM, kY, kYy, kQ, kQy, kQq, kColumnSums };
+  std::vector<int64_t> columns(kColumnSums * static_cast<size_t>(w), 0);
+  const auto add_row = [&](int y, int sign) {
+    const size_t at = static_cast<size_t>(y) * w;
+    for (int x = 0; x < w; ++x) {
+      if (frame_code_[at + x] != 0) continue;
+      // Rounded to nearest (disparities are above -1: the truncation of a positive number).
+      const int64_t q =
+          static_cast<int64_t>(frame_disparity_[at + x] * kFixed + (kFixed + 0.5)) - kFixedInt;
+      int64_t* c = &columns[kColumnSums * static_cast<size_t>(x)];
+      c[kM] += sign;
+      c[kY] += sign * y;
+      c[kYy] += sign * static_cast<int64_t>(y) * y;
+      c[kQ] += sign * q;
+      c[kQy] += sign * q * y;
+      c[kQq] += sign * q * q;
+    }
+  };
+  for (int y = v0 - rad; y < v0 + rad; ++y) add_row(y, 1);
+  // Prefix sums along the row of, per column x: m, sum q, x sum q, sum q y, sum q^2 (the rest of
+  // a window's moments are constant where all its pixels matched, and summed directly where not).
+  enum { kA0, kD0, kD1, kE0, kF0, kPrefixSums };
+  std::vector<int64_t> prefix(kPrefixSums * static_cast<size_t>(w + 1), 0);
+  std::vector<float> disparity(w);
+  // A full window's sum of i^2 (and of j^2): window sum_i i^2.
+  const int64_t full_sii = int64_t{options_.window_px} * rad * (rad + 1) * (2 * rad + 1) / 3;
+  for (int v = v0; v < v1; ++v) {
+    add_row(v + rad, 1);
+    if (v > v0) add_row(v - rad - 1, -1);
+    for (int x = 0; x < w; ++x) {
+      const int64_t* c = &columns[kColumnSums * static_cast<size_t>(x)];
+      const int64_t* p = &prefix[kPrefixSums * static_cast<size_t>(x)];
+      int64_t* next = &prefix[kPrefixSums * static_cast<size_t>(x + 1)];
+      next[kA0] = p[kA0] + c[kM];
+      next[kD0] = p[kD0] + c[kQ];
+      next[kD1] = p[kD1] + x * c[kQ];
+      next[kE0] = p[kE0] + c[kQy];
+      next[kF0] = p[kF0] + c[kQq];
+    }
+    const size_t row = static_cast<size_t>(v) * w;
+    const int* code = &frame_code_[row];
+    std::copy_n(&frame_disparity_[row], w, disparity.data());
+    for (int u = rad; u < w - rad; ++u) {
+      if (code[u] != 0) continue;
+      const int64_t* lo = &prefix[kPrefixSums * static_cast<size_t>(u - rad)];
+      const int64_t* hi = &prefix[kPrefixSums * static_cast<size_t>(u + rad + 1)];
+      const int64_t s0 = hi[kA0] - lo[kA0];
+      if (s0 < 0.5 * n) continue;
+      // The window's moments about its centre (i = x - u, j = y - v), exact.
+      const int64_t z_d0 = hi[kD0] - lo[kD0];
+      const double sd = z_d0 / kFixed;
+      const double sid = (hi[kD1] - lo[kD1] - u * z_d0) / kFixed;
+      const double sjd = (hi[kE0] - lo[kE0] - v * z_d0) / kFixed;
+      const double sdd = (hi[kF0] - lo[kF0]) / (kFixed * kFixed);
+      // Least squares d = a + g_u i + g_v j over the window's matched pixels.
+      double a, g_u, g_v;
+      if (s0 == options_.window_px * options_.window_px) {
+        // Every pixel: sum i = sum j = sum i j = 0, sum i^2 = sum j^2 = full_sii.
+        a = sd / n;
+        g_u = sid / full_sii;
+        g_v = sjd / full_sii;
+      } else {
+        int64_t si = 0, sii = 0, sj = 0, sij = 0, sjj = 0;
+        for (int i = -rad; i <= rad; ++i) {
+          const int64_t* c = &columns[kColumnSums * static_cast<size_t>(u + i)];
+          si += i * c[kM];
+          sii += i * i * c[kM];
+          sj += c[kY] - v * c[kM];
+          sij += i * (c[kY] - v * c[kM]);
+          sjj += c[kYy] - 2 * int64_t{v} * c[kY] + int64_t{v} * v * c[kM];
+        }
+        // Cramer's rule on the normal equations [s0 si sj; si sii sij; sj sij sjj] (a g_u g_v)^T
+        // = (sd sid sjd)^T.
+        const double m00 = s0, m01 = si, m02 = sj, m11 = sii, m12 = sij, m22 = sjj;
+        const double det = m00 * (m11 * m22 - m12 * m12) - m01 * (m01 * m22 - m12 * m02) +
+                           m02 * (m01 * m12 - m11 * m02);
+        if (!(det > 0.5)) continue;  // an integer determinant: 0 when the pixels are collinear
+        const double inverse_det = 1.0 / det;
+        a = (sd * (m11 * m22 - m12 * m12) - m01 * (sid * m22 - m12 * sjd) +
+             m02 * (sid * m12 - m11 * sjd)) *
+            inverse_det;
+        g_u = (m00 * (sid * m22 - m12 * sjd) - sd * (m01 * m22 - m12 * m02) +
+               m02 * (m01 * sjd - sid * m02)) *
+              inverse_det;
+        g_v = (m00 * (m11 * sjd - sid * m12) - m01 * (m01 * sjd - sid * m02) +
+               sd * (m01 * m12 - m11 * m02)) *
+              inverse_det;
+      }
+      const double residual = std::max(0.0, sdd - a * sd - g_u * sid - g_v * sjd) / s0;
+      if (!(residual <= kMaxResidualPx * kMaxResidualPx) || !(std::abs(g_u) <= kMaxGradient) ||
+          !(std::abs(g_v) <= kMaxGradient)) {
+        continue;
+      }
+      const double d1 = disparity[u];
+      if (first_order) {
+        // d1 >= 0 and u - x_min > max_d: a positive position, rounded by + 0.5.
+        const int k = std::min(static_cast<int>((u - d1 - x_min_) * kSubsamples + 0.5),
+                               columns_ * kSubsamples - 1);
+        // Sample k = 8 c + q of row v: (v columns + c) 8 + q.
+        const int8_t* centroid =
+            &centroids_[2 * (static_cast<size_t>(v) * columns_ * kSubsamples + k)];
+        const double c_u = centroid[0] / centroid_units_;
+        const double c_v = centroid[1] / centroid_units_;
+        disparity[u] = static_cast<float>(d1 - (g_u * c_u + g_v * c_v));
+      } else {
+        disparity[u] = static_cast<float>(ShearedDisparity(output, u, v, d1, g_u, g_v));
+      }
+    }
+    for (int start = 0; start < w; start += kSegment) {
+      const int span = std::min(kSegment, w - start);
+      Output(output, code + start, disparity.data() + start, span, depth + row + start,
+             cause != nullptr ? cause + row + start : nullptr);
+    }
+  }
+}
+
+double SpeckleMatcher::ShearedDisparity(const SpeckleOutput& output, int u, int v, double d1,
+                                        double g_u, double g_v) const {
+  const int rad = radius_;
+  const int window = options_.window_px;
+  const double n = static_cast<double>(window) * window;
+  const int stride = width_ + kBlock;
+  // The IR window's statistics.
+  int64_t a_sum = 0, a_square = 0;
+  for (int j = -rad; j <= rad; ++j) {
+    const int32_t* ir = &wide_ir_[static_cast<size_t>(v + j) * stride + (u - rad)];
+    for (int i = 0; i < window; ++i) {
+      a_sum += ir[i];
+      a_square += static_cast<int64_t>(ir[i]) * ir[i];
+    }
+  }
+  const double a_norm2 =
+      n * static_cast<double>(a_square) - static_cast<double>(a_sum) * static_cast<double>(a_sum);
+  if (!(a_norm2 > 0)) return d1;
+  const double inverse = 1.0 / std::sqrt(a_norm2);
+  const auto score = [&](double d) {
+    return SlantedScore(u, v, d, g_u, g_v, static_cast<double>(a_sum), inverse);
+  };
+  // The integer peak beside the first match's, then the three-point Gaussian fit (as Decide).
+  int d0 = static_cast<int>(std::floor(d1 + 0.5));
+  double left = score(d0 - 1), middle = score(d0), right = score(d0 + 1);
+  if (left > middle && left >= right) {
+    --d0;
+    right = middle;
+    middle = left;
+    left = score(d0 - 1);
+  } else if (right > middle) {
+    ++d0;
+    left = middle;
+    middle = right;
+    right = score(d0 + 1);
+  }
+  const bool positive = left > 0 && middle > 0 && right > 0;
+  const double l = positive ? std::log(left) : left;
+  const double m = positive ? std::log(middle) : middle;
+  const double r = positive ? std::log(right) : right;
+  const double curvature = l - 2.0 * m + r;
+  double offset = curvature < 0.0 ? 0.5 * (l - r) / curvature : 0.0;
+  offset = std::isfinite(offset) ? std::clamp(offset, -0.5, 0.5) : 0.0;
+  double refined = d0 + offset;
+  if (options_.lattice_search) {
+    // The raw lattice value whose sheared reference correlates best: a climb from the fit's.
+    const float steps = output.subpixel_steps;
+    int raw = static_cast<int>(std::floor(output.raw_offset - steps * refined + 0.5));
+    double best = score((output.raw_offset - raw) / steps);
+    for (const int step : {1, -1}) {
+      bool moved = false;
+      for (int tries = 0; tries < kSubsamples; ++tries) {
+        const double s = score((output.raw_offset - (raw + step)) / steps);
+        if (!(s > best)) break;
+        best = s;
+        raw += step;
+        moved = true;
+      }
+      if (moved) break;
+    }
+    refined = (output.raw_offset - raw) / steps;
+  }
+  return refined;
 }
 
 double SpeckleMatcher::LatticeScore(int u, int v, int raw, int32_t sum,

@@ -80,8 +80,11 @@ class SpeckleMatcher {
   // Row v's window statistics and searches into row r of the band's scratch.
   void PrepareRow(int v, int r, BandScratch& s) const;
   // Rows [v0, v1) (their windows inside the image).
+  // With first_code (slanted_windows) the verdicts and disparities go there and to
+  // first_disparity (#pixels) instead of depth and cause.
   void MatchBand(const SpeckleScene& scene, const SpeckleOutput& output, int v0, int v1,
-                 BandScratch& s, uint16_t* depth, MissingCause* cause) const;
+                 BandScratch& s, uint16_t* depth, MissingCause* cause, int* first_code,
+                 float* first_disparity) const;
   // StructuredLightOptions::lattice_search: the matched pixels of row v, columns [start, start +
   // n), moved to the raw lattice value whose reference shift correlates best (a climb from the
   // Gaussian fit's, within a pixel of the integer match).
@@ -92,6 +95,22 @@ class SpeckleMatcher {
   // The correlation of pixel (u, v)'s window, whose IR sum and inverse norm are given, with the
   // reference shifted by raw value `raw`.
   double LatticeScore(int u, int v, int raw, int32_t sum, double inverse_norm) const;
+  // StructuredLightOptions::slanted_windows: rows [v0, v1)'s matched pixels (frame_code_,
+  // frame_disparity_) refined by the plane fitted to the first match's disparities under each
+  // window, then turned into depth and cause.
+  void RefineSlantedRows(const SpeckleOutput& output, int v0, int v1, uint16_t* depth,
+                         MissingCause* cause) const;
+  // SlantedWindows::kSheared: pixel (u, v)'s disparity matched again with the window sheared by
+  // (g_u, g_v) [px/px], starting from d1; d1 where the window has no contrast.
+  double ShearedDisparity(const SpeckleOutput& output, int u, int v, double d1, double g_u,
+                          double g_v) const;
+  // SlantedWindows::kFirstOrder: centroids_, once per matcher.
+  void PrepareCentroids();
+  // The correlation of pixel (u, v)'s window (IR sum `sum`, inverse norm given) with the pattern
+  // at disparity d sheared by (g_u, g_v) [px/px]: window pixel (i, j) against the pattern at
+  // column u + i - d - g_u i - g_v j of row v + j (linear between its 1/8 px samples).
+  double SlantedScore(int u, int v, double d, double g_u, double g_v, double sum,
+                      double inverse_norm) const;
   // Depth and cause of n pixels from their verdicts and disparities.
   void Output(const SpeckleOutput& output, const int* code, const float* disparity, int n,
               uint16_t* depth, MissingCause* cause) const;
@@ -124,6 +143,18 @@ class SpeckleMatcher {
   float lattice_offset_ = -1;
   int lattice_floor_ = 0;  // floor(-raw_offset)
   double reference_scale_ = 0;
+  // slanted_windows, per frame and pixel: the first match's verdict (MissingCause) and disparity.
+  std::vector<int> frame_code_;
+  std::vector<float> frame_disparity_;
+  // SlantedWindows::kFirstOrder: per row, integer column c of the reference, 1/8 px phase q and
+  // axis (u, v), the centroid [1/centroid_units_ px] of (P(x + 1/2) - P(x - 1/2))^2 over the window
+  // centred at pattern position c + q/8 (P: the projected pattern of the window's rows); a row's
+  // in the order its pixels read them.
+  // |centroid| <= window_px / 2 px, so floor(127 / (window_px / 2)) units per px fit a byte (the
+  // default window: 31, rounding 1/62 px at most); a frame reads most of the table, and bytes
+  // halve that traffic.
+  double centroid_units_ = 0;
+  std::vector<int8_t> centroids_;
   // Scratch per worker thread (by its index in the task arena), kept from frame to frame.
   std::vector<std::unique_ptr<BandScratch>> scratch_;
 };
