@@ -35,14 +35,14 @@ struct Setup {
   std::unique_ptr<mmh::sim::KinectSensor> sensor;
 
   // sensor: 0 statistical, 1 structured light, 2 structured light matched on the IR camera's
-  // grid and registered (StructuredLightOptions::match_on_ir_grid), 3 and 4 structured light with
-  // slanted windows to first order and sheared (StructuredLightOptions::slanted_windows).
+  // grid and registered (StructuredLightOptions::match_on_ir_grid, the default), 3 and 4 the same
+  // with slanted windows to first order and sheared (StructuredLightOptions::slanted_windows).
   explicit Setup(int sensor_mode = 0) {
     config.scene.props = mmh::sim::TableProps::kCastle;
     // Both modes set explicitly: structured light is the default since 2026-11-29.
     config.sensor.mode = sensor_mode > 0 ? mmh::sim::SensorMode::kStructuredLight
                                          : mmh::sim::SensorMode::kStatistical;
-    config.sensor.structured_light.match_on_ir_grid = sensor_mode == 2;
+    config.sensor.structured_light.match_on_ir_grid = sensor_mode >= 2;
     config.sensor.structured_light.slanted_windows =
         sensor_mode == 3   ? mmh::sim::SlantedWindows::kFirstOrder
         : sensor_mode == 4 ? mmh::sim::SlantedWindows::kSheared
@@ -59,7 +59,7 @@ struct Setup {
 };
 
 // sensor_mode: Setup's (1: the structured-light mode, speckle image and block matching; 2: matched
-// on the IR camera's grid; 3, 4: slanted windows to first order, sheared).
+// on the IR camera's grid; 3, 4: and slanted windows to first order, sheared).
 Setup& SoldierScene(int worker, int sensor_mode = 0) {
   static std::vector<std::unique_ptr<Setup>> setups[5];
   auto& list = setups[sensor_mode];
@@ -141,8 +141,8 @@ BENCHMARK(BM_SensorFrame)
 // Frame-level parallelism (mmh::sim::RenderFrames): one scene and sensor per worker, 120 frames
 // of the demo walk per iteration. Args: mode, workers, cores (0: all; 1: everything on one
 // thread, as one job of the pipeline renders its session), sensor mode (1: structured light; 2:
-// structured light matched on the IR camera's grid and registered; 3, 4: structured light with
-// slanted windows to first order, sheared).
+// structured light matched on the IR camera's grid and registered; 3, 4: the same with slanted
+// windows to first order, sheared).
 void BM_SensorFrames(benchmark::State& state) {
   const RenderMode mode = state.range(0) == 0 ? RenderMode::kIncremental : RenderMode::kFull;
   std::unique_ptr<tbb::global_control> limit;

@@ -43,7 +43,7 @@ enum class SlantedWindows {
   kFirstOrder,
   // The window matched again against the pattern sheared by g (window pixel (i, j) against the
   // pattern at column u + i - d - g_u i - g_v j, linear between its 1/8 px samples), the peak's
-  // three-point Gaussian fit: exact, and about 12 times slower than the whole frame without it.
+  // three-point Gaussian fit: exact, and slow (about 0.27 s of CPU a frame; bench/README.md).
   kSheared,
 };
 std::span<const std::pair<SlantedWindows, const char*>> EnumNames(SlantedWindows);
