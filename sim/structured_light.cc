@@ -82,6 +82,12 @@ void StructuredLightOptions::Validate(const std::string& prefix) const {
   if (!std::isfinite(ambiguity_ratio) || ambiguity_ratio <= 0 || ambiguity_ratio > 1) {
     ThrowBadValue(prefix + ".ambiguity_ratio", FormatNumber(ambiguity_ratio), "a ratio in (0, 1]");
   }
+  if (slanted_windows != SlantedWindows::kOff && !parabola_subpixel) {
+    // Without the sub-pixel fit the diagnostic reports the rendered disparity: nothing to refine.
+    ThrowBadValue(prefix + ".slanted_windows",
+                  slanted_windows == SlantedWindows::kFirstOrder ? "first_order" : "sheared",
+                  "\"off\" with parabola_subpixel false");
+  }
   if (!std::isfinite(registration_growth_px) || registration_growth_px < 0 ||
       registration_growth_px > 1) {
     ThrowBadValue(prefix + ".registration_growth_px", FormatNumber(registration_growth_px),

@@ -106,7 +106,7 @@ struct StructuredLightOptions {
   // window as one disparity strays from the centre's by g . c, c the centroid of the pattern's
   // horizontal detail under the window (about |g| / sqrt(12 rho) px, rho dots per pixel, whatever
   // the window's size). A plane fitted to the first match's disparities under the window gives g.
-  // Skipped where parabola_subpixel is false.
+  // Requires parabola_subpixel (validated).
   SlantedWindows slanted_windows = SlantedWindows::kOff;
   // Match windows centred in the projector's shadow like any other, so that the correlation
   // decides (a window whose lit part correlates keeps its depth, as on the device, which does not

@@ -497,6 +497,11 @@ TEST(StructuredLight, NonsenseOptionsAreRejectedNamingTheField) {
   }
   SurfaceMaterial bad{1.5, 0.0};
   EXPECT_THROW(bad.Validate("scene.materials.table"), InputError);
+  StructuredLightOptions unrefined;
+  unrefined.parabola_subpixel = false;
+  unrefined.slanted_windows = SlantedWindows::kFirstOrder;
+  EXPECT_THAT(ErrorOf([&] { unrefined.Validate("sensor.structured_light"); }),
+              HasSubstr("sensor.structured_light.slanted_windows"));
   for (const auto& [density, brightness, field] :
        {std::tuple{-0.1, 0.2, "faint_dot_density"}, std::tuple{0.5, 0.0, "faint_dot_brightness"},
         std::tuple{0.5, 1.5, "faint_dot_brightness"}}) {
