@@ -980,6 +980,10 @@ void SpeckleMatcher::RefineSlantedRows(const SpeckleOutput& output, int v0, int 
   std::vector<float> disparity(w);
   // A full window's sum of i^2 (and of j^2): window sum_i i^2.
   const int64_t full_sii = int64_t{options_.window_px} * rad * (rad + 1) * (2 * rad + 1) / 3;
+  // Reciprocals: a division per pixel would cost more than the rest of its fit.
+  const double inverse_n = 1.0 / n;
+  const double inverse_full_sii = 1.0 / static_cast<double>(full_sii);
+  const double inverse_units = first_order ? 1.0 / centroid_units_ : 0.0;
   for (int v = v0; v < v1; ++v) {
     add_row(v + rad, 1);
     if (v > v0) add_row(v - rad - 1, -1);
@@ -1012,9 +1016,9 @@ void SpeckleMatcher::RefineSlantedRows(const SpeckleOutput& output, int v0, int 
       double a, g_u, g_v;
       if (s0 == options_.window_px * options_.window_px) {
         // Every pixel: sum i = sum j = sum i j = 0, sum i^2 = sum j^2 = full_sii.
-        a = sd / n;
-        g_u = sid / full_sii;
-        g_v = sjd / full_sii;
+        a = sd * inverse_n;
+        g_u = sid * inverse_full_sii;
+        g_v = sjd * inverse_full_sii;
       } else {
         int64_t si = 0, sii = 0, sj = 0, sij = 0, sjj = 0;
         for (int i = -rad; i <= rad; ++i) {
@@ -1042,9 +1046,10 @@ void SpeckleMatcher::RefineSlantedRows(const SpeckleOutput& output, int v0, int 
                sd * (m01 * m12 - m11 * m02)) *
               inverse_det;
       }
-      const double residual = std::max(0.0, sdd - a * sd - g_u * sid - g_v * sjd) / s0;
-      if (!(residual <= kMaxResidualPx * kMaxResidualPx) || !(std::abs(g_u) <= kMaxGradient) ||
-          !(std::abs(g_v) <= kMaxGradient)) {
+      // The residual's sum of squares against kMaxResidualPx^2 times the pixels (no division).
+      const double residual_sum = sdd - a * sd - g_u * sid - g_v * sjd;
+      if (!(residual_sum <= kMaxResidualPx * kMaxResidualPx * static_cast<double>(s0)) ||
+          !(std::abs(g_u) <= kMaxGradient) || !(std::abs(g_v) <= kMaxGradient)) {
         continue;
       }
       const double d1 = disparity[u];
@@ -1055,8 +1060,8 @@ void SpeckleMatcher::RefineSlantedRows(const SpeckleOutput& output, int v0, int 
         // Sample k = 8 c + q of row v: (v columns + c) 8 + q.
         const int8_t* centroid =
             &centroids_[2 * (static_cast<size_t>(v) * columns_ * kSubsamples + k)];
-        const double c_u = centroid[0] / centroid_units_;
-        const double c_v = centroid[1] / centroid_units_;
+        const double c_u = centroid[0] * inverse_units;
+        const double c_v = centroid[1] * inverse_units;
         disparity[u] = static_cast<float>(d1 - (g_u * c_u + g_v * c_v));
       } else {
         disparity[u] = static_cast<float>(ShearedDisparity(output, u, v, d1, g_u, g_v));
