@@ -674,8 +674,8 @@ void SpeckleMatcher::Match(const SpeckleScene& scene, const uint16_t* ir,
       std::fill_n(cause + static_cast<size_t>(v) * width_, width_, MissingCause::kBorder);
     }
   }
-  const bool slanted =
-      options_.slanted_windows != SlantedWindows::kOff && options_.parabola_subpixel;
+  // slanted_windows requires parabola_subpixel (StructuredLightOptions::Validate).
+  const bool slanted = options_.slanted_windows != SlantedWindows::kOff;
   if (slanted) {
     if (options_.slanted_windows == SlantedWindows::kFirstOrder) PrepareCentroids();
     frame_code_.assign(pixels, static_cast<int>(MissingCause::kBorder));

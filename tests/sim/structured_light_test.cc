@@ -81,6 +81,34 @@ RgbdFrame RenderWall(double z, const SurfaceMaterial& material, const KinectSens
   return sensor.Render(index, RenderMode::kFull);
 }
 
+// A wall of albedo 0.6 at 0.75 m turned turn_deg about the image's vertical, one full frame.
+RgbdFrame RenderTurnedWall(double turn_deg, const KinectSensorOptions& options) {
+  RayScene scene;
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(turn_deg * M_PI / 180, Eigen::Vector3d::UnitY()));
+  const Rigid3 wall_pose(turn * WallAt(0.0).rotation, Eigen::Vector3d(0, 0, 0.75));
+  scene.SetMaterial(scene.AddStatic("wall", Quad(4, 4), wall_pose), SurfaceMaterial{0.6, 0.0});
+  scene.Commit();
+  KinectSensor sensor(options, &scene, Rigid3::Identity());
+  return sensor.Render(0, RenderMode::kFull);
+}
+
+// The small-patch noise over the per-pixel model in the image's centre (240 x 200 px), with at
+// least 400 planar windows.
+double CentreNoiseOverModel(const RgbdFrame& frame, const KinectSensorOptions& options) {
+  const PinholeIntrinsics& in = frame.depth_intrinsics;
+  std::vector<float> depth_m(frame.depth.size(), 0.0f);
+  for (int v = 140; v < 340; ++v) {
+    for (int u = 200; u < 440; ++u) {
+      const size_t p = static_cast<size_t>(v) * in.width + u;
+      depth_m[p] = static_cast<float>(frame.depth[p] * frame.depth_scale);
+    }
+  }
+  const ErrorStructure e =
+      AnalyseErrorStructure(depth_m, in.width, in.height, in, options.calibration, options.axial);
+  EXPECT_GT(e.patches, 400);
+  return e.noise_over_model;
+}
+
 TEST(StructuredLight, WallsAtOneToThreeMetresMatchTheirDepthOnTheLattice) {
   const KinectCalibration calibration;
   for (const double z : {0.8, 1.2, 2.0, 3.0}) {
@@ -524,29 +552,11 @@ TEST(StructuredLight, FaintDotsBetweenTheBrightOnesQuietenSlantedSurfaces) {
   // population of dots pulls the match back towards the centre. A wall at 0.75 m turned 50 deg,
   // the small-patch noise over the per-pixel model in the image's centre (measured 0.84 without,
   // 0.72 with 0.6 faint dots per pixel of 0.35 the brightness; facing the camera 0.52 without).
-  RayScene scene;
-  const Eigen::Quaterniond turn(Eigen::AngleAxisd(50 * M_PI / 180, Eigen::Vector3d::UnitY()));
-  const Rigid3 wall_pose(turn * WallAt(0.0).rotation, Eigen::Vector3d(0, 0, 0.75));
-  scene.SetMaterial(scene.AddStatic("wall", Quad(4, 4), wall_pose), SurfaceMaterial{0.6, 0.0});
-  scene.Commit();
-  auto noise_over_model = [&](double faint_density) {
+  auto noise_over_model = [](double faint_density) {
     KinectSensorOptions options = StructuredLight();
     options.structured_light.faint_dot_density = faint_density;
     options.structured_light.faint_dot_brightness = 0.35;
-    KinectSensor sensor(options, &scene, Rigid3::Identity());
-    const RgbdFrame frame = sensor.Render(0, RenderMode::kFull);
-    const PinholeIntrinsics& in = frame.depth_intrinsics;
-    std::vector<float> depth_m(frame.depth.size(), 0.0f);
-    for (int v = 140; v < 340; ++v) {
-      for (int u = 200; u < 440; ++u) {
-        const size_t p = static_cast<size_t>(v) * in.width + u;
-        depth_m[p] = static_cast<float>(frame.depth[p] * frame.depth_scale);
-      }
-    }
-    const ErrorStructure e =
-        AnalyseErrorStructure(depth_m, in.width, in.height, in, options.calibration, options.axial);
-    EXPECT_GT(e.patches, 400);
-    return e.noise_over_model;
+    return CentreNoiseOverModel(RenderTurnedWall(50, options), options);
   };
   const double bright_only = noise_over_model(0.0);
   const double with_faint = noise_over_model(0.6);
@@ -565,30 +575,17 @@ TEST(StructuredLight, SlantedWindowsTakeTheSlopesExcessNoiseAway) {
     std::vector<uint16_t> depth;
   };
   auto render = [](double turn_deg, SlantedWindows slanted) {
-    RayScene scene;
-    const Eigen::Quaterniond turn(
-        Eigen::AngleAxisd(turn_deg * M_PI / 180, Eigen::Vector3d::UnitY()));
-    const Rigid3 wall_pose(turn * WallAt(0.0).rotation, Eigen::Vector3d(0, 0, 0.75));
-    scene.SetMaterial(scene.AddStatic("wall", Quad(4, 4), wall_pose), SurfaceMaterial{0.6, 0.0});
-    scene.Commit();
     KinectSensorOptions options = StructuredLight();
     options.structured_light.slanted_windows = slanted;
-    KinectSensor sensor(options, &scene, Rigid3::Identity());
-    const RgbdFrame frame = sensor.Render(0, RenderMode::kFull);
-    const PinholeIntrinsics& in = frame.depth_intrinsics;
+    const RgbdFrame frame = RenderTurnedWall(turn_deg, options);
     Result result;
-    std::vector<float> depth_m(frame.depth.size(), 0.0f);
     for (int v = 140; v < 340; ++v) {
       for (int u = 200; u < 440; ++u) {
-        const size_t p = static_cast<size_t>(v) * in.width + u;
-        depth_m[p] = static_cast<float>(frame.depth[p] * frame.depth_scale);
-        result.depth.push_back(frame.depth[p]);
+        result.depth.push_back(
+            frame.depth[static_cast<size_t>(v) * frame.depth_intrinsics.width + u]);
       }
     }
-    const ErrorStructure e =
-        AnalyseErrorStructure(depth_m, in.width, in.height, in, options.calibration, options.axial);
-    EXPECT_GT(e.patches, 400);
-    result.noise_over_model = e.noise_over_model;
+    result.noise_over_model = CentreNoiseOverModel(frame, options);
     return result;
   };
   auto rms_difference = [](const Result& a, const Result& b) {
