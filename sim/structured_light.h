@@ -106,8 +106,9 @@ struct StructuredLightOptions {
   // window as one disparity strays from the centre's by g . c, c the centroid of the pattern's
   // horizontal detail under the window (about |g| / sqrt(12 rho) px, rho dots per pixel, whatever
   // the window's size). A plane fitted to the first match's disparities under the window gives g.
-  // Requires parabola_subpixel (validated).
-  SlantedWindows slanted_windows = SlantedWindows::kOff;
+  // Requires parabola_subpixel (validated). First order by default since 2026-12-02: off leaves
+  // the real Xtion's small patches 1.66 times as noisy in the model (docs/sensor.md).
+  SlantedWindows slanted_windows = SlantedWindows::kFirstOrder;
   // Match windows centred in the projector's shadow like any other, so that the correlation
   // decides (a window whose lit part correlates keeps its depth, as on the device, which does not
   // know where the shadow is; docs/sensor.md, "The step law of the bands"); false rejects them

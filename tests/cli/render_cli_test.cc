@@ -403,8 +403,10 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   }
   // The view over time in structured light: from a still camera only the IR noise changes; moved
   // as the real camera moved, the pattern slides over the scene and the errors persist less at
-  // lag 4 (measured 0.648 and 0.636; the floor beyond the desk, whose windows at 1.4 m are
-  // mostly IR noise, new in every frame, thins the difference: 0.818 and 0.756 without it). On
+  // lag 4 (measured 0.464 and 0.431 with slanted windows to first order, the default since
+  // 2026-12-02, whose slopes no longer leave a fixed error; 0.648 and 0.636 with them off, where
+  // the floor beyond the desk, whose windows at 1.4 m are mostly IR noise, new in every frame,
+  // thins the difference: 0.818 and 0.756 without it). On
   // the IR camera's grid (the default) the registered frame's border loses the desk and the floor:
   // 422-510 planar windows a lag, against about 1 800 on the delivered grid.
   // Then the anchors from a still camera: ICL-NUIM's noise is new in every frame but for the raw
@@ -429,7 +431,7 @@ TEST_F(RenderCliTest, SensorCheckPrintsRealAndRenderedColumns) {
   for (const auto& row : view_temporal) {
     for (const auto& lag : row["lags"]) EXPECT_GT(lag["windows"].get<int>(), 300) << row.dump();
   }
-  EXPECT_GT(view_temporal[1]["lags"][2]["rho"].get<double>(), 0.5);
+  EXPECT_GT(view_temporal[1]["lags"][2]["rho"].get<double>(), 0.4);
   EXPECT_LT(view_temporal[2]["lags"][2]["rho"].get<double>(),
             view_temporal[1]["lags"][2]["rho"].get<double>() - 0.008);
   EXPECT_FALSE(view_temporal[1]["lags"][2].contains("following_the_surface"));

@@ -14,6 +14,7 @@
 #include "sim/kinect_sensor.h"
 #include "sim/primitives.h"
 #include "sim/render_session.h"
+#include "sim/structured_light.h"
 
 namespace mmh::sim {
 namespace {
@@ -52,27 +53,33 @@ TEST(RaySceneTest, FramesAreTheSameBytesOnEveryMachineWithAvx2) {
   scene.SetFrame(Rigid3(turn, Eigen::Vector3d(0.03, -0.02, 0.06)), 1.5);
   // The statistical mode, structured light matched on the colour camera's grid (the default
   // until 2026-11-30) and on the IR camera's (the default since), with windows centred in the
-  // projector's shadow rejected (the default until 2026-12-01) and matched (since). The last two
-  // hashes were measured on the Zen 4 only.
+  // projector's shadow rejected (the default until 2026-12-01) and matched (since), slanted
+  // windows off (until 2026-12-02) and to first order (since). The last three hashes were
+  // measured on the Zen 4 only.
   struct Case {
     SensorMode mode;
     bool ir_grid;
     bool in_shadow;
+    SlantedWindows slanted;
     const char* name;
     const char* hash;
   };
+  constexpr SlantedWindows kOff = SlantedWindows::kOff;
   for (const Case& c :
-       {Case{SensorMode::kStatistical, false, false, "statistical", "b89fa4f6009ba43f"},
-        Case{SensorMode::kStructuredLight, false, false, "structured light, colour grid",
+       {Case{SensorMode::kStatistical, false, false, kOff, "statistical", "b89fa4f6009ba43f"},
+        Case{SensorMode::kStructuredLight, false, false, kOff, "structured light, colour grid",
              "96bcea31c4137003"},
-        Case{SensorMode::kStructuredLight, true, false, "structured light, IR grid",
+        Case{SensorMode::kStructuredLight, true, false, kOff, "structured light, IR grid",
              "e35e4681fcc90857"},
-        Case{SensorMode::kStructuredLight, true, true, "structured light, IR grid, in the shadow",
-             "9ad7855efcf226ec"}}) {
+        Case{SensorMode::kStructuredLight, true, true, kOff,
+             "structured light, IR grid, in the shadow", "9ad7855efcf226ec"},
+        Case{SensorMode::kStructuredLight, true, true, SlantedWindows::kFirstOrder,
+             "structured light, IR grid, in the shadow, first order", "489af232fb03ad05"}}) {
     KinectSensorOptions options = config.sensor;
     options.mode = c.mode;
     options.structured_light.match_on_ir_grid = c.ir_grid;
     options.structured_light.match_in_shadow = c.in_shadow;
+    options.structured_light.slanted_windows = c.slanted;
     KinectSensor sensor(options, &scene.scene(), scene.table_T_camera());
     const RgbdFrame frame = sensor.Render(3);
     EXPECT_EQ(Hex(Fnv1a(frame.rgb, Fnv1a(frame.depth))), c.hash) << c.name;

@@ -334,6 +334,9 @@ void ExpectFewerLost(const std::function<void(sim::StructuredLightOptions&)>& se
   constexpr int kFrames = 60;
   sim::RenderConfig config = test_take::StatisticalConfig();
   config.sensor.mode = sim::SensorMode::kStructuredLight;
+  // Slanted windows off (the default until 2026-12-02), where these were measured; with the first
+  // order the plain tracker loses 8 of the window check's frames and 4 of the shadow's.
+  config.sensor.structured_light.slanted_windows = sim::SlantedWindows::kOff;
   sensor(config.sensor.structured_light);
   auto lost = [&](const ProxyTrackerOptions& options) {
     test_take::SimTake take(config);
@@ -573,6 +576,10 @@ test_take::SimTake StructuredLightStoryTake(const std::string& config_file, int 
   config["sensor"]["structured_light"]["min_correlation"] = 0.5;
   config["sensor"]["structured_light"]["match_on_ir_grid"] = false;
   config["sensor"]["structured_light"]["match_in_shadow"] = false;
+  // Slanted windows off (the default until 2026-12-02): with the first order, soldier.json's take
+  // 1 shows no twin in frames 0-269 either, and mario.json's take 2 enters one from frame 200 on
+  // for 32 frames with the plain tracker.
+  config["sensor"]["structured_light"]["slanted_windows"] = "off";
   const std::filesystem::path file = dir / std::filesystem::path(config_file).filename();
   std::ofstream(file) << config.dump();
   return test_take::SoldierStorySession(MMH_SOURCE_DIR, 0, take_index,
