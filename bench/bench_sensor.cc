@@ -35,8 +35,9 @@ struct Setup {
   std::unique_ptr<mmh::sim::KinectSensor> sensor;
 
   // sensor: 0 statistical, 1 structured light, 2 structured light matched on the IR camera's
-  // grid and registered (StructuredLightOptions::match_on_ir_grid, the default), 3 and 4 the same
-  // with slanted windows to first order and sheared (StructuredLightOptions::slanted_windows).
+  // grid and registered (StructuredLightOptions::match_on_ir_grid) with slanted windows off (the
+  // default until 2026-12-02), 3 and 4 the same with slanted windows to first order (the default
+  // since) and sheared (StructuredLightOptions::slanted_windows).
   explicit Setup(int sensor_mode = 0) {
     config.scene.props = mmh::sim::TableProps::kCastle;
     // Both modes set explicitly: structured light is the default since 2026-11-29.
