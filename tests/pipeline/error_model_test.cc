@@ -546,14 +546,16 @@ TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
   // The core's time scales: what the data identify is the autocorrelation, here at lag 1 (over
   // 12 seeds of these takes, 2026-11-30, within 0.007 of the defaults'). The fast part's ρ_f
   // alone trades off against the slow part (w, ρ_s): over the same seeds it came back
-  // 0.132 ± 0.005 (sd) against the defaults' 0.147, with w and ρ_s a little larger to
-  // compensate, so it is held to that bias and 4 sd. (Until 2026-11-30 ρ_f was held to 0.02:
-  // seed 700 passed at the previous defaults, 0.144, and failed at these, 0.124.)
+  // 0.132 ± 0.005 (sd) against the defaults' 0.147 of 2026-11-30, with w and ρ_s a little larger
+  // to compensate. At the defaults of 2026-12-02 (seeds 700-711, the lag-1 autocorrelation
+  // within 0.002) ρ_f comes back 0.068 ± 0.005 against 0.107, w 0.503 against 0.485 and ρ_s
+  // 0.965 against 0.958, so it is held to that bias and 4 sd. (Until 2026-11-30 ρ_f was held to
+  // 0.02: seed 700 passed at the previous defaults, 0.144, and failed at these, 0.124.)
   auto lag_one = [](const ErrorModelOptions& m) {
     return m.slow_share * m.slow_correlation + (1 - m.slow_share) * m.correlation;
   };
   EXPECT_NEAR(lag_one(fit), lag_one(options), 0.02);
-  EXPECT_NEAR(fit.correlation, options.correlation, 0.015 + 4 * 0.005);
+  EXPECT_NEAR(fit.correlation, options.correlation - 0.039, 4 * 0.005);
   // Pooled over the frames: Σ_c rate_c · at-risk frames is the expected number of starts.
   double expected = 0, fitted = 0;
   for (int c = 0; c < kViewConditions; ++c) {
@@ -563,8 +565,12 @@ TEST(ErrorModelTest, TheDefaultsAreRecoveredFromTheirOwnSimulation) {
   }
   EXPECT_TRUE(estimate.corrected);
   EXPECT_NEAR(fitted, expected, 4 * std::sqrt(expected)) << "spike starts";
-  // The spikes' sizes: the per-axis RMS of about 8 000 episodes' draws, within 4 standard errors.
-  const double size_tolerance = 4 / std::sqrt(2 * 3 * expected);
+  // The spikes' sizes: the per-axis RMS of about 8 000 episodes' draws. Over seeds 700-711 at the
+  // defaults of 2026-12-02 the fit's spread is twice the draws' standard error (sd 0.9 % for the
+  // rotation, 1.1 % for the translation: the correction by simulation samples too) and the
+  // translation's mean 1.0 % high (the pooled fit's bias, above): held to 1 % and 4 of the
+  // measured sd. (At 4 draws' standard errors, 1.7 %, seed 700 failed the translation by 2.4 %.)
+  const double size_tolerance = 0.01 + 4 * 0.011;
   EXPECT_NEAR(fit.spike_rotation_sd, options.spike_rotation_sd,
               size_tolerance * options.spike_rotation_sd);
   EXPECT_NEAR(fit.spike_translation_sd, options.spike_translation_sd,
