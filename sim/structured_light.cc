@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/options.h"
 
 namespace mmh::sim {
 namespace {
@@ -84,8 +85,7 @@ void StructuredLightOptions::Validate(const std::string& prefix) const {
   }
   if (slanted_windows != SlantedWindows::kOff && !parabola_subpixel) {
     // Without the sub-pixel fit the diagnostic reports the rendered disparity: nothing to refine.
-    ThrowBadValue(prefix + ".slanted_windows",
-                  slanted_windows == SlantedWindows::kFirstOrder ? "first_order" : "sheared",
+    ThrowBadValue(prefix + ".slanted_windows", EnumName(slanted_windows),
                   "\"off\" with parabola_subpixel false");
   }
   if (!std::isfinite(registration_growth_px) || registration_growth_px < 0 ||
